@@ -1,0 +1,10 @@
+// Brute force: every ray tests every triangle. The reference that all tests compare against.
+#pragma once
+
+#include "cellrt/accel.hpp"
+
+namespace cellrt {
+
+std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangles, const AccelConfig& config);
+
+}  // namespace cellrt

@@ -1,0 +1,42 @@
+// The study's renderer: one primary ray per pixel, and for every hit one shadow ray toward the point
+// light; diffuse shading with a little ambient light, a sky colour for misses.
+#pragma once
+
+#include <atomic>
+#include <functional>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/image.hpp"
+#include "cellrt/scene.hpp"
+
+namespace cellrt {
+
+struct RenderOptions {
+    int width = 512;
+    int height = 512;
+    unsigned threads = 0;  // 0: all hardware threads
+    int tile = 16;         // tile edge in pixels; a tile is one batch for the accelerator
+    bool count = false;    // collect traversal counters
+    // Called now and then from worker threads with (tiles done, tiles in all).
+    std::function<void(std::size_t, std::size_t)> progress;
+    // Set to true (for example from a signal handler) to stop early; render() then throws.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+struct RenderStats {
+    double seconds = 0.0;
+    std::uint64_t primary_rays = 0;
+    std::uint64_t shadow_rays = 0;
+    TraversalCounters primary, shadow;  // filled when RenderOptions::count
+};
+
+Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,
+             RenderStats* stats = nullptr);
+
+// Shadow-ray origin for a hit point p on a surface with geometric normal n (facing the side the
+// ray came from): p pushed off the surface by a few ulps of its own magnitude, so the ray cannot
+// hit the surface it starts on (Wächter & Binder, "A Fast and Robust Method for Avoiding
+// Self-Intersection", Ray Tracing Gems, ch. 6).
+Vec3 offset_ray_origin(const Vec3& p, const Vec3& n);
+
+}  // namespace cellrt

@@ -1,0 +1,49 @@
+// A scene: triangles, a pinhole camera, one point light and an image size, loaded from a view file,
+// a bare mesh (OBJ or PLY, with a default view) or a built-in procedural generator.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cellrt/box.hpp"
+#include "cellrt/triangle.hpp"
+
+namespace cellrt {
+
+struct Camera {
+    Vec3 position{0.f, 0.f, 1.f};
+    Vec3 look_at{0.f, 0.f, 0.f};
+    Vec3 up{0.f, 1.f, 0.f};
+    float fov_y_deg = 60.f;  // full vertical field of view, in (0, 180)
+};
+
+struct PointLight {
+    Vec3 position{0.f, 10.f, 0.f};
+    Vec3 color{1.f, 1.f, 1.f};
+};
+
+struct Scene {
+    std::string name;
+    std::vector<Triangle> triangles;
+    Camera camera;
+    PointLight light;
+    int width = 512;
+    int height = 512;
+
+    Box3 bounds() const;
+};
+
+// Loads `spec`: a view file (*.json, format of shared/scenes/README.md), a mesh (*.obj, *.ply) shown
+// by default_view(), or `builtin:NAME[?key=value&...]` (builtin.hpp). Throws cellrt::Error with a
+// message naming the file and line or the field at fault.
+Scene load_scene(const std::string& spec);
+
+// A camera looking at the whole of `bounds` from the front-upper-right and a light above it; used
+// for bare meshes.
+void set_default_view(Scene& scene);
+
+// Checks what every loader guarantees: at least one triangle, all coordinates finite, a valid camera
+// (see PinholeCamera) and a positive image size. Throws cellrt::Error naming `where` otherwise.
+void validate_scene(const Scene& scene, const std::string& where);
+
+}  // namespace cellrt

@@ -1,0 +1,97 @@
+// Triangles and the watertight ray-triangle test (Woop, Benthin, Wald: "Watertight Ray/Triangle
+// Intersection", JCGT 2(1), 2013). It is the one triangle kernel of cellrt: brute force and every
+// acceleration structure call it, so equal inputs give bit-equal t on every path.
+//
+// Why watertight: the test shears and scales the triangle into a space where the ray is the +z
+// axis through the origin, then evaluates the three 2D edge functions. Neighbouring triangles share
+// the exact same edge-function value for a shared edge (same vertices, same arithmetic), so a ray
+// through an edge or a vertex is inside at least one of them. Edge values of exactly zero are
+// recomputed in double precision (section 3 of the paper) so that the sign of a tiny value is right.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+
+#include "cellrt/box.hpp"
+#include "cellrt/ray.hpp"
+
+namespace cellrt {
+
+struct Triangle {
+    Vec3 v0, v1, v2;
+
+    Box3 bounds() const {
+        Box3 b;
+        b.extend(v0);
+        b.extend(v1);
+        b.extend(v2);
+        return b;
+    }
+    Vec3 geometric_normal() const { return cross(v1 - v0, v2 - v0); }
+    friend bool operator==(const Triangle&, const Triangle&) = default;
+};
+static_assert(sizeof(Triangle) == 36);
+
+// Per-ray constants of the test, computed once per ray (section 2 of the paper).
+struct WatertightRay {
+    Vec3 org;
+    int kx = 0, ky = 1, kz = 2;
+    float sx = 0.f, sy = 0.f, sz = 0.f;
+
+    explicit WatertightRay(const Ray& r) : org(r.org) {
+        kz = max_axis(r.dir);
+        kx = kz == 2 ? 0 : kz + 1;
+        ky = kx == 2 ? 0 : kx + 1;
+        if (r.dir[kz] < 0.f) std::swap(kx, ky);  // keeps the winding, so the sign test is orientation-free
+        sx = r.dir[kx] / r.dir[kz];
+        sy = r.dir[ky] / r.dir[kz];
+        sz = 1.f / r.dir[kz];
+    }
+};
+
+// Core of the test: on success writes t = T/det and the barycentrics, without any range check.
+// Returns false when the ray misses the triangle's plane region or the triangle is degenerate
+// (det == 0: zero area, or seen edge-on).
+inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+    const Vec3 a = tri.v0 - r.org, b = tri.v1 - r.org, c = tri.v2 - r.org;
+    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
+    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
+    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    float eu = cx * by - cy * bx;
+    float ev = ax * cy - ay * cx;
+    float ew = bx * ay - by * ax;
+    if (eu == 0.f || ev == 0.f || ew == 0.f) {
+        eu = static_cast<float>(double(cx) * double(by) - double(cy) * double(bx));
+        ev = static_cast<float>(double(ax) * double(cy) - double(ay) * double(cx));
+        ew = static_cast<float>(double(bx) * double(ay) - double(by) * double(ax));
+    }
+    if ((eu < 0.f || ev < 0.f || ew < 0.f) && (eu > 0.f || ev > 0.f || ew > 0.f)) return false;
+    const float det = eu + ev + ew;
+    if (det == 0.f) return false;
+    const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    const float big_t = eu * az + ev * bz + ew * cz;
+    const float inv_det = 1.f / det;
+    t = big_t * inv_det;
+    u = ev * inv_det;
+    v = ew * inv_det;
+    return true;
+}
+
+// Closest-hit step: updates `best` when the triangle is hit at ray.tnear <= t <= best.t and is
+// preferred by the hit rule (ray.hpp). Returns whether `best` changed.
+inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, std::uint32_t prim,
+                              Hit& best) {
+    float t, u, v;
+    if (!intersect_unbounded(r, tri, t, u, v)) return false;
+    if (!(t >= tnear) || !closer(t, prim, best)) return false;
+    best = Hit{t, prim, u, v};
+    return true;
+}
+
+// Any-hit step: whether the triangle is hit at tnear <= t <= tfar.
+inline bool intersect_any(const WatertightRay& r, float tnear, float tfar, const Triangle& tri) {
+    float t, u, v;
+    return intersect_unbounded(r, tri, t, u, v) && t >= tnear && t <= tfar;
+}
+
+}  // namespace cellrt

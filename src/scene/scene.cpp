@@ -1,0 +1,77 @@
+#include "cellrt/scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include "cellrt/builtin.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
+
+namespace cellrt {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
+}  // namespace
+
+Box3 Scene::bounds() const {
+    Box3 b;
+    for (const Triangle& t : triangles) b.extend(t.bounds());
+    return b;
+}
+
+void set_default_view(Scene& scene) {
+    const Box3 b = scene.bounds();
+    const Vec3 c = b.center();
+    const float radius = std::max(0.5f * length(b.extent()), 1e-6f);
+    const Vec3 dir = normalize(Vec3{1.f, 0.6f, 1.4f});
+    scene.camera.fov_y_deg = 45.f;
+    // Distance at which a sphere of `radius` fits in a 45-degree field of view, with a margin.
+    scene.camera.position = c + dir * (radius * 2.8f);
+    scene.camera.look_at = c;
+    scene.camera.up = {0.f, 1.f, 0.f};
+    scene.light.position = c + Vec3{-0.6f, 1.5f, 0.9f} * (radius * 2.f);
+    scene.light.color = {1.f, 1.f, 1.f};
+}
+
+void validate_scene(const Scene& scene, const std::string& where) {
+    if (scene.triangles.empty()) throw Error(where + ": the mesh has no triangles");
+    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+        const Triangle& t = scene.triangles[i];
+        if (!is_finite(t.v0) || !is_finite(t.v1) || !is_finite(t.v2))
+            throw Error(where + ": triangle " + std::to_string(i) + " has a non-finite coordinate");
+    }
+    if (!is_finite(scene.light.position)) throw Error(where + ": the light position is not finite");
+    try {
+        PinholeCamera(scene.camera, scene.width, scene.height);
+    } catch (const Error& e) {
+        throw Error(where + ": " + e.what());
+    }
+}
+
+std::vector<Triangle> load_mesh(const std::string& path) {
+    const std::string ext = lower_extension(path);
+    if (ext == ".obj") return load_obj(path);
+    throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj)");
+}
+
+Scene load_scene(const std::string& spec) {
+    if (spec.rfind("builtin:", 0) == 0) return make_builtin_scene(spec);
+    if (!std::filesystem::exists(spec)) throw Error(spec + ": no such file");
+    if (lower_extension(spec) == ".json") return load_view_file(spec);
+    Scene scene;
+    scene.name = std::filesystem::path(spec).stem().string();
+    scene.triangles = load_mesh(spec);
+    if (scene.triangles.empty()) throw Error(spec + ": the mesh has no triangles");
+    set_default_view(scene);
+    validate_scene(scene, spec);
+    return scene;
+}
+
+}  // namespace cellrt

@@ -1,0 +1,99 @@
+// View files: JSON with mesh, camera, light and image (shared/scenes/README.md).
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
+#include "read_file.hpp"
+
+namespace cellrt {
+namespace {
+
+using nlohmann::json;
+
+class ViewReader {
+public:
+    explicit ViewReader(const std::string& path) : path_(path) {}
+
+    [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+        throw Error(path_ + ": field '" + field + "' " + what);
+    }
+
+    const json& field(const json& parent, const std::string& parent_name, const char* key) const {
+        const std::string name = parent_name.empty() ? key : parent_name + "." + key;
+        if (!parent.is_object() || !parent.contains(key)) fail(name, "is missing");
+        return parent.at(key);
+    }
+
+    double number(const json& j, const std::string& name) const {
+        if (!j.is_number()) fail(name, "must be a number");
+        const double v = j.get<double>();
+        if (!std::isfinite(v)) fail(name, "must be finite");
+        return v;
+    }
+
+    Vec3 vec3(const json& parent, const std::string& parent_name, const char* key) const {
+        const std::string name = parent_name + "." + key;
+        const json& j = field(parent, parent_name, key);
+        if (!j.is_array() || j.size() != 3) fail(name, "must be an array of three numbers");
+        return {static_cast<float>(number(j[0], name + "[0]")), static_cast<float>(number(j[1], name + "[1]")),
+                static_cast<float>(number(j[2], name + "[2]"))};
+    }
+
+    int positive_int(const json& parent, const std::string& parent_name, const char* key) const {
+        const std::string name = parent_name + "." + key;
+        const json& j = field(parent, parent_name, key);
+        if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > 65536)
+            fail(name, "must be an integer in [1, 65536]");
+        return static_cast<int>(j.get<long long>());
+    }
+
+    Scene read() const {
+        const std::string text = detail::read_file(path_);
+        json doc;
+        try {
+            doc = json::parse(text, nullptr, true, /*ignore_comments=*/true);
+        } catch (const json::parse_error& e) {
+            throw Error(path_ + ": invalid JSON: " + e.what());
+        }
+        if (!doc.is_object()) throw Error(path_ + ": a view file must be a JSON object");
+
+        const json& mesh = field(doc, "", "mesh");
+        if (!mesh.is_string() || mesh.get<std::string>().empty()) fail("mesh", "must be a non-empty string");
+        const std::filesystem::path mesh_path =
+            std::filesystem::path(path_).parent_path() / mesh.get<std::string>();
+
+        Scene scene;
+        scene.name = doc.contains("name") && doc["name"].is_string()
+                         ? doc["name"].get<std::string>()
+                         : std::filesystem::path(path_).stem().string();
+        const json& cam = field(doc, "", "camera");
+        scene.camera.position = vec3(cam, "camera", "position");
+        scene.camera.look_at = vec3(cam, "camera", "look_at");
+        scene.camera.up = vec3(cam, "camera", "up");
+        scene.camera.fov_y_deg = static_cast<float>(number(field(cam, "camera", "fov_y_deg"), "camera.fov_y_deg"));
+
+        const json& light = field(doc, "", "light");
+        if (light.contains("type") && light["type"] != "point") fail("light.type", "must be \"point\"");
+        scene.light.position = vec3(light, "light", "position");
+        if (light.contains("color")) scene.light.color = vec3(light, "light", "color");
+
+        const json& image = field(doc, "", "image");
+        scene.width = positive_int(image, "image", "width");
+        scene.height = positive_int(image, "image", "height");
+
+        scene.triangles = load_mesh(mesh_path.string());
+        validate_scene(scene, path_);
+        return scene;
+    }
+
+private:
+    std::string path_;
+};
+
+}  // namespace
+
+Scene load_view_file(const std::string& path) { return ViewReader(path).read(); }
+
+}  // namespace cellrt

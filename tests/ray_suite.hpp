@@ -1,0 +1,221 @@
+// Ray sets that every acceleration structure must answer exactly as brute force does, and the
+// comparison itself. One place, so that every structure faces the same edge cases:
+// random rays from outside and inside the scene, axis-parallel rays with +0 and -0 components,
+// rays aimed exactly at vertices, at edge points and at axis planes through vertices (where split
+// planes lie), rays whose tfar ends exactly at or just before the reference hit, rays with
+// tnear > 0, and invalid rays (NaN, infinite, zero direction, tnear > tfar).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/brute_force.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace cellrt::test {
+
+struct RaySuiteOptions {
+    std::size_t random = 20000;       // origins in the enlarged scene box, directions uniform
+    std::size_t inside = 20000;       // origins inside the scene box
+    std::size_t axis_parallel = 6000; // directions along +-x, +-y, +-z with signed zero components
+    std::size_t vertices = 20000;     // aimed exactly at a vertex
+    std::size_t edges = 20000;        // aimed at a point on an edge (incl. midpoints)
+    std::size_t planes = 10000;       // origin on an axis plane through a vertex, or direction within it
+    std::uint32_t seed = 12345;
+};
+
+class RaySuite {
+public:
+    RaySuite(std::span<const Triangle> tris, const RaySuiteOptions& o) : tris_(tris), rng_(o.seed) {
+        for (const Triangle& t : tris) bounds_.extend(t.bounds());
+        const Vec3 e = max(bounds_.extent(), Vec3(1e-3f));
+        outer_ = {bounds_.lo - e * 0.5f, bounds_.hi + e * 0.5f};
+        for (std::size_t i = 0; i < o.random; ++i) add(point_in(outer_), random_dir());
+        for (std::size_t i = 0; i < o.inside; ++i) add(point_in(bounds_), random_dir());
+        for (std::size_t i = 0; i < o.axis_parallel; ++i) add(point_in(outer_), axis_dir(i));
+        for (std::size_t i = 0; i < o.vertices; ++i) aim_at(vertex());
+        for (std::size_t i = 0; i < o.edges; ++i) aim_at(edge_point(i));
+        for (std::size_t i = 0; i < o.planes; ++i) plane_ray(i);
+        add_invalid();
+    }
+
+    const std::vector<Ray>& rays() const { return rays_; }
+
+    // Copies of `rays` with tfar cut at the reference hit (exactly, and one ulp before) and with
+    // tnear moved past it, so interval limits are checked at their edges.
+    static std::vector<Ray> limited(const std::vector<Ray>& rays, const std::vector<Hit>& reference) {
+        std::vector<Ray> out;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            if (!reference[i].is_hit()) continue;
+            Ray r = rays[i];
+            r.tfar = reference[i].t;
+            out.push_back(r);
+            r.tfar = std::nextafter(reference[i].t, 0.f);
+            out.push_back(r);
+            r.tfar = kInfinity;
+            r.tnear = reference[i].t;
+            out.push_back(r);
+            r.tnear = std::nextafter(reference[i].t, kInfinity);
+            out.push_back(r);
+        }
+        return out;
+    }
+
+private:
+    float uniform(float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng_); }
+    Vec3 point_in(const Box3& b) { return {uniform(b.lo.x, b.hi.x), uniform(b.lo.y, b.hi.y), uniform(b.lo.z, b.hi.z)}; }
+    Vec3 random_dir() {
+        for (;;) {
+            const Vec3 d{uniform(-1.f, 1.f), uniform(-1.f, 1.f), uniform(-1.f, 1.f)};
+            if (dot(d, d) > 1e-4f && dot(d, d) <= 1.f) return normalize(d);
+        }
+    }
+    Vec3 axis_dir(std::size_t i) {
+        const float zero = (i / 6) % 2 ? -0.f : 0.f;
+        Vec3 d(zero);
+        d[(i % 6) / 2] = (i % 2) ? -1.f : 1.f;
+        return d;
+    }
+    const Triangle& triangle() { return tris_[std::uniform_int_distribution<std::size_t>(0, tris_.size() - 1)(rng_)]; }
+    Vec3 vertex() {
+        const Triangle& t = triangle();
+        const int k = std::uniform_int_distribution<int>(0, 2)(rng_);
+        return k == 0 ? t.v0 : (k == 1 ? t.v1 : t.v2);
+    }
+    Vec3 edge_point(std::size_t i) {
+        const Triangle& t = triangle();
+        const float s = (i % 4 == 0) ? 0.5f : uniform(0.f, 1.f);
+        switch (i % 3) {
+            case 0: return t.v0 + (t.v1 - t.v0) * s;
+            case 1: return t.v1 + (t.v2 - t.v1) * s;
+            default: return t.v2 + (t.v0 - t.v2) * s;
+        }
+    }
+    void aim_at(const Vec3& target) {
+        const Vec3 org = point_in(outer_);
+        const Vec3 d = target - org;
+        if (dot(d, d) > 0.f) add(org, d);  // not normalised: the target lies exactly at t = 1 when representable
+    }
+    // Rays lying in, starting on or parallel to an axis plane through a vertex: where kd-tree
+    // split planes and BIH clip planes sit.
+    void plane_ray(std::size_t i) {
+        const Vec3 v = vertex();
+        const int axis = static_cast<int>(i % 3);
+        Vec3 org = point_in(outer_);
+        org[axis] = v[axis];
+        Vec3 d = random_dir();
+        if (i % 2) d[axis] = (i % 4 == 1) ? 0.f : -0.f;  // inside the plane
+        if (dot(d, d) > 0.f) add(org, d);
+    }
+    void add_invalid() {
+        const float nan = std::nanf("");
+        const Vec3 c = bounds_.center();
+        add({nan, c.y, c.z}, {1.f, 0.f, 0.f});
+        add(c, {nan, 0.f, 1.f});
+        add(c, {0.f, 0.f, 0.f});
+        add({kInfinity, 0.f, 0.f}, {-1.f, 0.f, 0.f});
+        add(c, {kInfinity, 1.f, 0.f});
+        Ray r;
+        r.org = outer_.lo;
+        r.dir = normalize(c - outer_.lo);
+        r.tnear = 2.f;
+        r.tfar = 1.f;
+        rays_.push_back(r);
+        r.tnear = nan;
+        r.tfar = kInfinity;
+        rays_.push_back(r);
+    }
+    void add(const Vec3& org, const Vec3& dir) {
+        Ray r;
+        r.org = org;
+        r.dir = dir;
+        rays_.push_back(r);
+        // Every tenth ray also starts a little way along (tnear > 0).
+        if (rays_.size() % 10 == 0) {
+            r.tnear = uniform(0.f, 0.5f) * length(bounds_.extent()) / std::max(length(dir), 1e-20f);
+            rays_.push_back(r);
+        }
+    }
+
+    std::span<const Triangle> tris_;
+    std::mt19937 rng_;
+    Box3 bounds_, outer_;
+    std::vector<Ray> rays_;
+};
+
+inline std::string describe(const Ray& r) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "org (%a, %a, %a) dir (%a, %a, %a) tnear %a tfar %a", r.org.x, r.org.y, r.org.z,
+                  r.dir.x, r.dir.y, r.dir.z, r.tnear, r.tfar);
+    return buf;
+}
+
+// Reference answers of brute force for a ray set, computed once (in parallel) and shared by every
+// structure and traversal tested on the same scene.
+struct ReferenceAnswers {
+    std::vector<Ray> rays;
+    std::vector<Hit> hits;
+    std::vector<std::uint8_t> occluded;
+};
+
+inline ReferenceAnswers compute_reference(std::span<const Triangle> tris, std::vector<Ray> rays) {
+    const auto brute = make_brute_force(tris, AccelConfig{"brute"});
+    ReferenceAnswers ref;
+    ref.rays = std::move(rays);
+    ref.hits.resize(ref.rays.size());
+    ref.occluded.resize(ref.rays.size());
+    const std::span<const Ray> all(ref.rays);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.size(), 256), [&](const auto& r) {
+        const auto n = r.end() - r.begin();
+        brute->intersect(all.subspan(r.begin(), n), std::span(ref.hits).subspan(r.begin(), n));
+        brute->occluded(all.subspan(r.begin(), n), std::span(ref.occluded).subspan(r.begin(), n));
+    });
+    return ref;
+}
+
+// The suite's rays, followed by up to `limited_count` of them limited at their reference hits.
+inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {},
+                                        std::size_t limited_count = 20000) {
+    ReferenceAnswers ref = compute_reference(tris, RaySuite(tris, options).rays());
+    std::vector<Ray> limited = RaySuite::limited(ref.rays, ref.hits);
+    if (limited.size() > limited_count) limited.resize(limited_count);
+    ReferenceAnswers lim = compute_reference(tris, std::move(limited));
+    ref.rays.insert(ref.rays.end(), lim.rays.begin(), lim.rays.end());
+    ref.hits.insert(ref.hits.end(), lim.hits.begin(), lim.hits.end());
+    ref.occluded.insert(ref.occluded.end(), lim.occluded.begin(), lim.occluded.end());
+    return ref;
+}
+
+// Compares closest hits (t, triangle, barycentrics) and any-hit answers of `tested` with the
+// reference; reports the first few differences in full. Returns the number of differing rays.
+inline std::size_t expect_matches(const Accelerator& tested, const ReferenceAnswers& ref, const std::string& what) {
+    std::vector<Hit> got(ref.rays.size());
+    std::vector<std::uint8_t> got_occ(ref.rays.size());
+    const std::span<const Ray> all(ref.rays);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.size(), 256), [&](const auto& r) {
+        const auto n = r.end() - r.begin();
+        tested.intersect(all.subspan(r.begin(), n), std::span(got).subspan(r.begin(), n));
+        tested.occluded(all.subspan(r.begin(), n), std::span(got_occ).subspan(r.begin(), n));
+    });
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < ref.rays.size(); ++i) {
+        if (got[i] == ref.hits[i] && got_occ[i] == ref.occluded[i]) continue;
+        if (++bad <= 5)
+            ADD_FAILURE() << what << ": ray " << i << " " << describe(ref.rays[i]) << "\n  closest: got prim "
+                          << got[i].prim << " t " << got[i].t << ", want prim " << ref.hits[i].prim << " t "
+                          << ref.hits[i].t << "\n  occluded: got " << int(got_occ[i]) << ", want "
+                          << int(ref.occluded[i]);
+    }
+    EXPECT_EQ(bad, 0u) << what << ": " << bad << " of " << ref.rays.size() << " rays differ from brute force";
+    return bad;
+}
+
+}  // namespace cellrt::test

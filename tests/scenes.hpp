@@ -1,0 +1,27 @@
+// Access to the shared scenes for tests: their folder, and a skip with a message when absent.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace cellrt::test {
+
+inline std::string scenes_dir() {
+    if (const char* env = std::getenv("CELLRT_SCENES")) return env;
+    return CELLRT_SCENES_DIR;
+}
+
+// Path of a shared scene's view file, e.g. shared_view("teapot"); empty when absent.
+inline std::string shared_view(const std::string& name) {
+    const auto p = std::filesystem::path(scenes_dir()) / name / (name + ".json");
+    return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+#define CELLRT_REQUIRE_SHARED_SCENE(path_var, name)                                                      \
+    const std::string path_var = ::cellrt::test::shared_view(name);                                     \
+    if (path_var.empty()) GTEST_SKIP() << "shared scene '" << name << "' not found under "               \
+                                       << ::cellrt::test::scenes_dir() << " (set CELLRT_SCENES)"
+
+}  // namespace cellrt::test

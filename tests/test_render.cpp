@@ -1,0 +1,102 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/builtin.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/render.hpp"
+
+namespace cellrt {
+namespace {
+
+Image render_with(const Scene& scene, const std::string& accel_kind, unsigned threads, int w, int h) {
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{accel_kind});
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.threads = threads;
+    o.tile = 8;
+    return render(scene, *accel, o);
+}
+
+bool same_bits(const Image& a, const Image& b) {
+    return a.width == b.width && a.height == b.height &&
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec3)) == 0;
+}
+
+TEST(Render, SameImageAtOneAndFourThreads) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=800");
+    const Image one = render_with(scene, "brute", 1, 61, 47);
+    const Image four = render_with(scene, "brute", 4, 61, 47);
+    EXPECT_TRUE(same_bits(one, four));
+}
+
+// A unit square floor lit from straight above, with a small box floating over its centre: the point
+// under the box is in shadow, a point near a corner is lit, and a ray above the horizon sees sky.
+TEST(Render, ShadowedAndLitPixelsWhereTheyMustBe) {
+    Scene scene;
+    scene.triangles = {{{-2.f, 0.f, -2.f}, {-2.f, 0.f, 2.f}, {2.f, 0.f, 2.f}},
+                       {{-2.f, 0.f, -2.f}, {2.f, 0.f, 2.f}, {2.f, 0.f, -2.f}},
+                       // occluder: a horizontal square at y = 1 over the centre
+                       {{-0.3f, 1.f, -0.3f}, {-0.3f, 1.f, 0.3f}, {0.3f, 1.f, 0.3f}},
+                       {{-0.3f, 1.f, -0.3f}, {0.3f, 1.f, 0.3f}, {0.3f, 1.f, -0.3f}}};
+    scene.light.position = {0.f, 5.f, 0.f};
+    // Seen obliquely, so that the floor under the occluder is visible past it.
+    scene.camera = {{0.f, 3.f, 5.f}, {0.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, 60.f};
+    const int w = 96, h = 96;
+    const Image img = render_with(scene, "brute", 2, w, h);
+    const PinholeCamera cam(scene.camera, w, h);
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"brute"});
+    // Find pixels whose primary ray hits the floor near (0,0,0) (under the occluder) and near (1.5,0,1.5).
+    float best_centre = kInfinity, best_corner = kInfinity;
+    Vec3 centre_px, corner_px;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Ray r = cam.primary(x, y);
+            Hit hit;
+            accel->intersect(std::span(&r, 1), std::span(&hit, 1));
+            if (!hit.is_hit() || hit.prim > 1) continue;
+            const Vec3 p = r.org + r.dir * hit.t;
+            const float dc = length(p), dk = length(p - Vec3{1.5f, 0.f, 1.5f});
+            if (dc < best_centre) best_centre = dc, centre_px = img.at(x, y);
+            if (dk < best_corner) best_corner = dk, corner_px = img.at(x, y);
+        }
+    ASSERT_LT(best_centre, 0.2f);
+    ASSERT_LT(best_corner, 0.2f);
+    EXPECT_GT(corner_px.x, 0.5f) << "floor away from the occluder must be lit";
+    EXPECT_LT(centre_px.x, 0.15f) << "floor under the occluder must be in shadow (ambient only)";
+    const Vec3 sky_px = img.at(0, 0);
+    EXPECT_GT(sky_px.z, sky_px.x) << "top row sees the blue sky";
+}
+
+TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=400");
+    const Image img = render_with(scene, "brute", 2, 20, 10);
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_test_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "img.pfm").string();
+    write_image(img, path, false);
+    EXPECT_TRUE(same_bits(read_pfm(path), img));
+    EXPECT_THROW(write_image(img, path, false), Error);
+    EXPECT_NO_THROW(write_image(img, path, true));
+    EXPECT_THROW(write_image(img, (dir / "no" / "such" / "x.png").string(), false), Error);
+    EXPECT_THROW(write_image(img, (dir / "x.bmp").string(), false), Error);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Render, ShadowOriginLeavesTheSurface) {
+    // A hit point far from the origin, pushed along its normal, must lie strictly on the normal side.
+    for (const Vec3 p : {Vec3{1000.f, 2.f, -3.f}, Vec3{0.001f, 0.f, 0.f}, Vec3{-12345.f, 678.f, 0.5f}}) {
+        const Vec3 n{0.f, 1.f, 0.f};
+        const Vec3 o = offset_ray_origin(p, n);
+        EXPECT_GT(o.y, p.y);
+        EXPECT_EQ(o.x, p.x);
+    }
+}
+
+}  // namespace
+}  // namespace cellrt
