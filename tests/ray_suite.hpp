@@ -9,6 +9,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <span>
 #include <string>
@@ -192,6 +195,17 @@ inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const Ra
     ref.hits.insert(ref.hits.end(), lim.hits.begin(), lim.hits.end());
     ref.occluded.insert(ref.occluded.end(), lim.occluded.begin(), lim.occluded.end());
     return ref;
+}
+
+// reference_suite() of a named triangle set, computed once per test program and shared by every
+// structure and traversal tested on it (brute force over a shared scene takes tens of seconds).
+inline const ReferenceAnswers& cached_reference(const std::string& key, std::span<const Triangle> tris) {
+    static std::mutex mutex;
+    static std::map<std::string, std::unique_ptr<ReferenceAnswers>> cache;
+    std::lock_guard lock(mutex);
+    auto& slot = cache[key];
+    if (!slot) slot = std::make_unique<ReferenceAnswers>(reference_suite(tris));
+    return *slot;
 }
 
 // Compares closest hits (t, triangle, barycentrics) and any-hit answers of `tested` with the

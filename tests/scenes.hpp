@@ -4,7 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
+
+#include "cellrt/scene.hpp"
 
 namespace cellrt::test {
 
@@ -17,6 +22,16 @@ inline std::string scenes_dir() {
 inline std::string shared_view(const std::string& name) {
     const auto p = std::filesystem::path(scenes_dir()) / name / (name + ".json");
     return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+// Loads a scene once per test program (by spec: view file path or builtin:...).
+inline const Scene& cached_scene(const std::string& spec) {
+    static std::mutex mutex;
+    static std::map<std::string, std::unique_ptr<Scene>> cache;
+    std::lock_guard lock(mutex);
+    auto& slot = cache[spec];
+    if (!slot) slot = std::make_unique<Scene>(load_scene(spec));
+    return *slot;
 }
 
 #define CELLRT_REQUIRE_SHARED_SCENE(path_var, name)                                                      \
