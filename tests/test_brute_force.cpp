@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
 #include "ray_suite.hpp"
 #include "scenes.hpp"
 
