@@ -19,7 +19,7 @@ Image render_with(const Scene& scene, const std::string& accel_kind, unsigned th
     o.width = w;
     o.height = h;
     o.threads = threads;
-    o.tile = 8;
+    o.packet = 8;
     return render(scene, *accel, o);
 }
 

@@ -8,16 +8,19 @@
 #include "cellrt/accel.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/scene.hpp"
+#include "cellrt/schedule.hpp"
 
 namespace cellrt {
 
 struct RenderOptions {
     int width = 512;
     int height = 512;
-    unsigned threads = 0;  // 0: all hardware threads
-    int tile = 16;         // tile edge in pixels; a tile is one batch for the accelerator
+    unsigned threads = 0;  // worker threads; 0: all hardware threads
+    int packet = 16;       // packet edge P in pixels: a P x P packet is one batch for the accelerator
+    Dispatch dispatch = Dispatch::pull;  // how packets reach the workers (schedule.hpp)
+    bool pin = false;      // pin worker threads to cores
     bool count = false;    // collect traversal counters
-    // Called now and then from worker threads with (tiles done, tiles in all).
+    // Called now and then with (packets done, packets in all).
     std::function<void(std::size_t, std::size_t)> progress;
     // Set to true (for example from a signal handler) to stop early; render() then throws.
     const std::atomic<bool>* cancel = nullptr;
@@ -38,5 +41,9 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
 // hit the surface it starts on (Wächter & Binder, "A Fast and Robust Method for Avoiding
 // Self-Intersection", Ray Tracing Gems, ch. 6).
 Vec3 offset_ray_origin(const Vec3& p, const Vec3& n);
+
+// The renderer's shadow ray from hit point p with viewer-facing normal n toward a point light:
+// origin offset_ray_origin(p, n), unit direction, tnear 0, tfar just short of the light.
+Ray shadow_ray(const Vec3& p, const Vec3& n, const Vec3& light);
 
 }  // namespace cellrt

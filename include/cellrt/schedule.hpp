@@ -1,0 +1,65 @@
+// Work distribution for a frame: the image cut into packets of P x P pixels, and the two ways of
+// handing packets to worker threads that the scaling study compares.
+//
+// - mailbox: the study's section 4.1. One master thread owns the packet counter; it hands each packet
+//   to an idle worker through that worker's single-slot mailbox, waits for the worker's colours and
+//   writes them into the frame buffer. Every packet passes through the master twice, which is why the
+//   study saw no scaling past two workers with 2 x 2 packets.
+// - pull: workers claim packets from a shared atomic counter and write the frame buffer themselves;
+//   nothing is serialised but the counter.
+// Both give the same image: a pixel's colour depends only on its own rays.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <string>
+
+#include "cellrt/image.hpp"
+
+namespace cellrt {
+
+enum class Dispatch { pull, mailbox };
+
+Dispatch parse_dispatch(const std::string& name);  // "pull" | "mailbox"; throws cellrt::Error
+const char* to_string(Dispatch d);
+
+struct PixelRect {
+    int x0, y0, x1, y1;  // half-open
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    int pixels() const { return width() * height(); }
+};
+
+// The image in packets of `packet` x `packet` pixels, row-major; packets at the right and bottom
+// edges are cut to the image (partial packets are traced, never dropped).
+struct PacketGrid {
+    int width, height, packet;
+
+    PacketGrid(int w, int h, int p);
+    int columns() const { return (width + packet - 1) / packet; }
+    int rows() const { return (height + packet - 1) / packet; }
+    std::size_t count() const { return static_cast<std::size_t>(columns()) * rows(); }
+    PixelRect rect(std::size_t index) const;
+};
+
+struct ScheduleOptions {
+    Dispatch dispatch = Dispatch::pull;
+    unsigned workers = 0;  // 0: all hardware threads
+    bool pin = false;      // pin worker i to core i (Linux; ignored where unavailable)
+    const std::atomic<bool>* cancel = nullptr;
+    std::function<void(std::size_t, std::size_t)> progress;  // (packets done, packets in all)
+};
+
+// Computes the colours of one packet (row-major over rect, rect.pixels() entries) on worker `worker`.
+using PacketTracer = std::function<void(unsigned worker, const PixelRect& rect, std::span<Vec3> colours)>;
+
+// Number of worker threads `options` asks for.
+unsigned worker_count(const ScheduleOptions& options);
+
+// Traces every packet of `grid` into `image` (which must be grid.width x grid.height).
+// Returns false when cancelled before all packets were traced.
+bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace);
+
+}  // namespace cellrt

@@ -1,0 +1,183 @@
+#include "cellrt/schedule.hpp"
+
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#ifdef __linux__
+#include <pthread.h>
+#include <sched.h>
+#endif
+
+#include "cellrt/error.hpp"
+
+namespace cellrt {
+namespace {
+
+void pin_to_core(std::thread& t, unsigned core) {
+#ifdef __linux__
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(core % std::max(1u, std::thread::hardware_concurrency()), &set);
+    pthread_setaffinity_np(t.native_handle(), sizeof set, &set);
+#else
+    (void)t;
+    (void)core;
+#endif
+}
+
+void store(Image& image, const PixelRect& r, std::span<const Vec3> colours) {
+    for (int y = r.y0; y < r.y1; ++y)
+        for (int x = r.x0; x < r.x1; ++x) image.at(x, y) = colours[static_cast<std::size_t>(y - r.y0) * r.width() + (x - r.x0)];
+}
+
+bool cancelled(const ScheduleOptions& o) { return o.cancel && o.cancel->load(std::memory_order_relaxed); }
+
+bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
+              unsigned workers) {
+    std::atomic<std::size_t> next{0}, done{0};
+    auto work = [&](unsigned w) {
+        std::vector<Vec3> colours(static_cast<std::size_t>(grid.packet) * grid.packet);
+        for (std::size_t p = next.fetch_add(1, std::memory_order_relaxed); p < grid.count();
+             p = next.fetch_add(1, std::memory_order_relaxed)) {
+            if (cancelled(options)) return;
+            const PixelRect r = grid.rect(p);
+            const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
+            trace(w, r, out);
+            store(image, r, out);
+            const std::size_t finished = done.fetch_add(1, std::memory_order_relaxed) + 1;
+            if (options.progress) options.progress(finished, grid.count());
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < workers; ++w) {
+        pool.emplace_back(work, w);
+        if (options.pin) pin_to_core(pool.back(), w);
+    }
+    for (auto& t : pool) t.join();
+    return done.load() == grid.count();
+}
+
+// One worker's single-slot mailbox: the master posts a packet, the worker posts its colours back.
+struct Mailbox {
+    enum class State { idle, work, done, stop };
+    std::mutex mutex;
+    std::condition_variable to_worker;
+    State state = State::idle;
+    PixelRect rect{};
+    std::vector<Vec3> colours;
+};
+
+bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
+                 unsigned workers) {
+    std::vector<Mailbox> boxes(workers);
+    std::mutex master_mutex;
+    std::condition_variable to_master;
+    for (Mailbox& b : boxes) b.colours.resize(static_cast<std::size_t>(grid.packet) * grid.packet);
+
+    auto work = [&](unsigned w) {
+        Mailbox& box = boxes[w];
+        for (;;) {
+            std::unique_lock lock(box.mutex);
+            box.to_worker.wait(lock, [&] { return box.state == Mailbox::State::work || box.state == Mailbox::State::stop; });
+            if (box.state == Mailbox::State::stop) return;
+            const PixelRect r = box.rect;
+            lock.unlock();
+            trace(w, r, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(r.pixels())));
+            {
+                std::lock_guard master_lock(master_mutex);
+                lock.lock();
+                box.state = Mailbox::State::done;
+            }
+            to_master.notify_one();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < workers; ++w) {
+        pool.emplace_back(work, w);
+        if (options.pin) pin_to_core(pool.back(), w);
+    }
+
+    // The master: collect finished packets into the frame buffer, hand out the next ones.
+    std::size_t next = 0, done = 0, in_flight = 0;
+    auto any_in = [&](Mailbox::State s) {
+        for (Mailbox& b : boxes) {
+            std::lock_guard l(b.mutex);
+            if (b.state == s) return true;
+        }
+        return false;
+    };
+    for (;;) {
+        const bool more = next < grid.count() && !cancelled(options);
+        if (in_flight == 0 && !more) break;
+        {
+            std::unique_lock master_lock(master_mutex);
+            to_master.wait(master_lock, [&] {
+                return any_in(Mailbox::State::done) ||
+                       (next < grid.count() && !cancelled(options) && any_in(Mailbox::State::idle));
+            });
+        }
+        for (Mailbox& b : boxes) {
+            std::unique_lock l(b.mutex);
+            if (b.state == Mailbox::State::done) {
+                store(image, b.rect, std::span<const Vec3>(b.colours.data(), static_cast<std::size_t>(b.rect.pixels())));
+                b.state = Mailbox::State::idle;
+                --in_flight;
+                ++done;
+                if (options.progress) options.progress(done, grid.count());
+            }
+            if (b.state == Mailbox::State::idle && next < grid.count() && !cancelled(options)) {
+                b.rect = grid.rect(next++);
+                b.state = Mailbox::State::work;
+                ++in_flight;
+                l.unlock();
+                b.to_worker.notify_one();
+            }
+        }
+    }
+    for (Mailbox& b : boxes) {
+        {
+            std::lock_guard l(b.mutex);
+            b.state = Mailbox::State::stop;
+        }
+        b.to_worker.notify_one();
+    }
+    for (auto& t : pool) t.join();
+    return done == grid.count();
+}
+
+}  // namespace
+
+Dispatch parse_dispatch(const std::string& name) {
+    if (name == "pull") return Dispatch::pull;
+    if (name == "mailbox") return Dispatch::mailbox;
+    throw Error("--dispatch '" + name + "' must be pull or mailbox");
+}
+
+const char* to_string(Dispatch d) { return d == Dispatch::pull ? "pull" : "mailbox"; }
+
+PacketGrid::PacketGrid(int w, int h, int p) : width(w), height(h), packet(p) {
+    if (w < 1 || h < 1) throw Error("image size must be positive");
+    if (p < 1 || p > 256) throw Error("--packet " + std::to_string(p) + " must lie in [1, 256]");
+}
+
+PixelRect PacketGrid::rect(std::size_t index) const {
+    const int cx = static_cast<int>(index % static_cast<std::size_t>(columns()));
+    const int cy = static_cast<int>(index / static_cast<std::size_t>(columns()));
+    const int x0 = cx * packet, y0 = cy * packet;
+    return {x0, y0, std::min(x0 + packet, width), std::min(y0 + packet, height)};
+}
+
+unsigned worker_count(const ScheduleOptions& options) {
+    return options.workers ? options.workers : std::max(1u, std::thread::hardware_concurrency());
+}
+
+bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace) {
+    if (image.width != grid.width || image.height != grid.height) throw Error("frame buffer does not match the packet grid");
+    const unsigned workers = worker_count(options);
+    return options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, workers)
+                                              : run_mailbox(grid, options, image, trace, workers);
+}
+
+}  // namespace cellrt

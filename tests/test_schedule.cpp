@@ -1,0 +1,93 @@
+// The packet scheduler: every dispatch mode, worker count and packet size gives the same image.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/render.hpp"
+#include "scenes.hpp"
+
+namespace cellrt {
+namespace {
+
+bool same_bits(const Image& a, const Image& b) {
+    return a.width == b.width && a.height == b.height &&
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec3)) == 0;
+}
+
+Image render_scene(const Scene& scene, const Accelerator& accel, int w, int h, Dispatch d, unsigned workers, int packet) {
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.dispatch = d;
+    o.threads = workers;
+    o.packet = packet;
+    return render(scene, accel, o);
+}
+
+TEST(Schedule, SameImageForEveryDispatchWorkerCountAndPacketSize) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=400");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"brute"});
+    // 37 x 29 is a multiple of no packet size > 1: edge packets are partial.
+    const Image reference = render_scene(scene, *accel, 37, 29, Dispatch::pull, 1, 1);
+    for (Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        for (unsigned workers : {1u, 2u, 3u, 6u})
+            for (int packet : {1, 2, 4, 8, 16})
+                EXPECT_TRUE(same_bits(render_scene(scene, *accel, 37, 29, d, workers, packet), reference))
+                    << to_string(d) << " workers " << workers << " packet " << packet;
+}
+
+TEST(Schedule, MoreWorkersThanPackets) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=400");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"brute"});
+    const Image reference = render_scene(scene, *accel, 10, 6, Dispatch::pull, 1, 4);
+    for (Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        EXPECT_TRUE(same_bits(render_scene(scene, *accel, 10, 6, d, 8, 16), reference)) << to_string(d);
+}
+
+TEST(Schedule, EveryPixelIsWrittenOnce) {
+    const PacketGrid grid(23, 17, 8);
+    Image image(23, 17);
+    for (Dispatch d : {Dispatch::pull, Dispatch::mailbox}) {
+        std::fill(image.pixels.begin(), image.pixels.end(), Vec3{});
+        ScheduleOptions o;
+        o.dispatch = d;
+        o.workers = 3;
+        ASSERT_TRUE(run_packets(grid, o, image, [](unsigned, const PixelRect& r, std::span<Vec3> out) {
+            ASSERT_EQ(out.size(), static_cast<std::size_t>(r.pixels()));
+            for (int y = r.y0; y < r.y1; ++y)
+                for (int x = r.x0; x < r.x1; ++x)
+                    out[static_cast<std::size_t>(y - r.y0) * r.width() + (x - r.x0)] = Vec3{float(x), float(y), 1.f};
+        }));
+        for (int y = 0; y < 17; ++y)
+            for (int x = 0; x < 23; ++x) ASSERT_EQ(image.at(x, y), (Vec3{float(x), float(y), 1.f})) << to_string(d);
+    }
+}
+
+TEST(Schedule, CancellationStopsEarlyAndReportsIt) {
+    const PacketGrid grid(64, 64, 2);
+    Image image(64, 64);
+    for (Dispatch d : {Dispatch::pull, Dispatch::mailbox}) {
+        std::atomic<bool> cancel{false};
+        std::atomic<std::size_t> traced{0};
+        ScheduleOptions o;
+        o.dispatch = d;
+        o.workers = 2;
+        o.cancel = &cancel;
+        o.progress = [&](std::size_t done, std::size_t) {
+            if (done == 10) cancel = true;
+        };
+        EXPECT_FALSE(run_packets(grid, o, image, [&](unsigned, const PixelRect&, std::span<Vec3>) { ++traced; }));
+        EXPECT_LT(traced.load(), grid.count() / 2) << to_string(d);
+    }
+}
+
+TEST(Schedule, RejectsBadSettings) {
+    EXPECT_THROW(PacketGrid(16, 16, 0), Error);
+    EXPECT_THROW(parse_dispatch("push"), Error);
+    EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
+}
+
+}  // namespace
+}  // namespace cellrt
