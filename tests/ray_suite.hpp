@@ -8,7 +8,14 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -197,14 +204,91 @@ inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const Ra
     return ref;
 }
 
-// reference_suite() of a named triangle set, computed once per test program and shared by every
-// structure and traversal tested on it (brute force over a shared scene takes tens of seconds).
+// Brute force over a shared scene and the whole suite takes tens of seconds, and CTest runs every
+// test in a process of its own, so reference answers are kept on disk (in the build tree) under a
+// key made of the scene's triangles and the rays. A cached file is trusted only after a sample of
+// its answers is recomputed and found equal, so a changed triangle kernel cannot leave stale answers.
+namespace detail {
+
+inline std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ull) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+inline bool read_reference(const std::string& path, std::size_t rays, ReferenceAnswers& out) {
+    std::ifstream in(path, std::ios::binary);
+    std::uint64_t n = 0;
+    if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n != rays) return false;
+    out.rays.resize(n);
+    out.hits.resize(n);
+    out.occluded.resize(n);
+    in.read(reinterpret_cast<char*>(out.rays.data()), static_cast<std::streamsize>(n * sizeof(Ray)));
+    in.read(reinterpret_cast<char*>(out.hits.data()), static_cast<std::streamsize>(n * sizeof(Hit)));
+    in.read(reinterpret_cast<char*>(out.occluded.data()), static_cast<std::streamsize>(n));
+    return static_cast<bool>(in);
+}
+
+inline void write_reference(const std::string& path, const ReferenceAnswers& ref) {
+    const std::string temp = path + ".part" + std::to_string(::getpid());
+    {
+        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+        const std::uint64_t n = ref.rays.size();
+        out.write(reinterpret_cast<const char*>(&n), sizeof n);
+        out.write(reinterpret_cast<const char*>(ref.rays.data()), static_cast<std::streamsize>(n * sizeof(Ray)));
+        out.write(reinterpret_cast<const char*>(ref.hits.data()), static_cast<std::streamsize>(n * sizeof(Hit)));
+        out.write(reinterpret_cast<const char*>(ref.occluded.data()), static_cast<std::streamsize>(n));
+    }
+    std::filesystem::rename(temp, path);
+}
+
+// Recomputes every 97th answer of `ref` with brute force.
+inline bool sample_agrees(std::span<const Triangle> tris, const ReferenceAnswers& ref) {
+    std::vector<Ray> sample;
+    std::vector<std::size_t> at;
+    for (std::size_t i = 0; i < ref.rays.size(); i += 97) sample.push_back(ref.rays[i]), at.push_back(i);
+    const ReferenceAnswers check = compute_reference(tris, sample);
+    for (std::size_t k = 0; k < at.size(); ++k)
+        if (!(check.hits[k] == ref.hits[at[k]]) || check.occluded[k] != ref.occluded[at[k]]) return false;
+    return true;
+}
+
+}  // namespace detail
+
+// reference_suite() of a triangle set, computed once and shared by every structure and traversal
+// tested on it: in memory within a process, on disk across processes (CELLRT_TEST_CACHE).
 inline const ReferenceAnswers& cached_reference(const std::string& key, std::span<const Triangle> tris) {
     static std::mutex mutex;
     static std::map<std::string, std::unique_ptr<ReferenceAnswers>> cache;
     std::lock_guard lock(mutex);
     auto& slot = cache[key];
-    if (!slot) slot = std::make_unique<ReferenceAnswers>(reference_suite(tris));
+    if (slot) return *slot;
+    const std::vector<Ray> rays = RaySuite(tris, RaySuiteOptions{}).rays();
+    const std::uint64_t h = detail::fnv1a(rays.data(), rays.size() * sizeof(Ray),
+                                          detail::fnv1a(tris.data(), tris.size_bytes()));
+    std::filesystem::create_directories(CELLRT_TEST_CACHE);
+    char name[32];
+    std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(h));
+    const std::string path = std::string(CELLRT_TEST_CACHE) + "/" + name + ".ref";
+    // One process computes, the others wait for its file.
+    const int lock_fd = ::open((path + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
+    if (lock_fd >= 0) ::flock(lock_fd, LOCK_EX);
+    auto ref = std::make_unique<ReferenceAnswers>();
+    std::size_t expected = 0;
+    {
+        std::ifstream in(path, std::ios::binary);
+        std::uint64_t n = 0;
+        if (in.read(reinterpret_cast<char*>(&n), sizeof n)) expected = n;
+    }
+    if (expected == 0 || !detail::read_reference(path, expected, *ref) || !detail::sample_agrees(tris, *ref)) {
+        *ref = reference_suite(tris);
+        detail::write_reference(path, *ref);
+    }
+    if (lock_fd >= 0) {
+        ::flock(lock_fd, LOCK_UN);
+        ::close(lock_fd);
+    }
+    slot = std::move(ref);
     return *slot;
 }
 

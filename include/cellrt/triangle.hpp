@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 
 #include "cellrt/box.hpp"
@@ -78,13 +79,18 @@ inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, flo
 }
 
 // Closest-hit step: updates `best` when the triangle is hit at ray.tnear <= t <= best.t and is
-// preferred by the hit rule (ray.hpp). Returns whether `best` changed.
-inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, std::uint32_t prim,
-                              Hit& best) {
+// preferred by the hit rule (ray.hpp). Returns whether `best` changed. `prim` is the triangle's index,
+// or a callable returning it (read only when the hit is a candidate, for structures that keep it apart).
+template <class Prim>
+inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, Prim&& prim, Hit& best) {
     float t, u, v;
     if (!intersect_unbounded(r, tri, t, u, v)) return false;
-    if (!(t >= tnear) || !closer(t, prim, best)) return false;
-    best = Hit{t, prim, u, v};
+    if (!(t >= tnear) || !(t <= best.t)) return false;
+    std::uint32_t index;
+    if constexpr (std::is_invocable_v<Prim>) index = prim();
+    else index = prim;
+    if (!closer(t, index, best)) return false;
+    best = Hit{t, index, u, v};
     return true;
 }
 

@@ -7,6 +7,8 @@
 
 #include "cellrt/brute_force.hpp"
 #include "cellrt/error.hpp"
+#include "bih/bih_accel.hpp"
+#include "kdtree/kd_accel.hpp"
 
 namespace cellrt {
 
@@ -22,6 +24,8 @@ struct Entry {
 // The one list of structures this binary offers.
 constexpr Entry kAccelerators[] = {
     {"brute", &make_brute_force},
+    {"kd", &detail::make_kdtree},
+    {"bih", &detail::make_bih},
 };
 
 std::string join(const std::vector<std::string>& items) {

@@ -1,0 +1,74 @@
+// Deterministic parallel tree layout, shared by the kd-tree and BIH builders.
+//
+// A builder splits large nodes into two tasks; each task builds its subtree into a Subtree of its
+// own, numbered from 0. flatten() then lays the pieces out depth-first with the two children of
+// every inner node adjacent (a pair starting at an even index), which is exactly the layout a
+// single-threaded build produces. So the final bytes depend only on the tree, never on which thread
+// built what or how the work was cut.
+//
+// Node requirements: is_leaf(), children() (inner: index of the child pair), first() (leaf: first
+// entry of its index list) and with_index(i) (a copy whose child pair or first entry is i).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <tbb/info.h>
+
+#include "cellrt/error.hpp"
+
+namespace cellrt::detail {
+
+template <class Node>
+struct Subtree {
+    // nodes[0] is the root; child pairs follow in local numbering. When the root's children were
+    // built as tasks of their own, `left` and `right` hold them and `nodes` holds only the root.
+    std::vector<Node> nodes;
+    // Leaf index lists in local numbering (structures whose leaves index a shared array leave it empty).
+    std::vector<std::uint32_t> indices;
+    std::unique_ptr<Subtree> left, right;
+    double cost = 0.0;  // the builder's estimate, for retraction
+};
+
+// Threads a build may use: the user's count (0: all), never more than the machine has.
+inline int build_concurrency(unsigned requested) {
+    const int cores = tbb::info::default_concurrency();
+    return requested == 0 ? cores : std::min(cores, static_cast<int>(requested));
+}
+
+// Checks an index against the `max` a node can encode; throws naming the structure otherwise.
+inline std::uint32_t checked_node_index(std::size_t i, std::uint32_t max, const char* structure) {
+    if (i > max)
+        throw Error(std::string(structure) + ": more nodes or leaf references than its node format can address; "
+                                             "the scene is too large (lower max_depth)");
+    return static_cast<std::uint32_t>(i);
+}
+
+// Appends the subtree `s` whose root goes to nodes[slot] (already allocated).
+template <class Node>
+void flatten(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& nodes, std::vector<std::uint32_t>& indices,
+             std::uint32_t max_index, const char* structure) {
+    if (s.left) {
+        const auto pair = checked_node_index(nodes.size() + 1, max_index, structure) - 1;
+        nodes.resize(nodes.size() + 2);
+        nodes[slot] = s.nodes[0].with_index(pair);
+        flatten(*s.left, pair, nodes, indices, max_index, structure);
+        flatten(*s.right, pair + 1, nodes, indices, max_index, structure);
+        return;
+    }
+    const auto base = static_cast<std::uint32_t>(nodes.size());
+    const auto first_index = static_cast<std::uint32_t>(indices.size());
+    indices.insert(indices.end(), s.indices.begin(), s.indices.end());
+    checked_node_index(indices.size(), max_index, structure);
+    checked_node_index(nodes.size() + s.nodes.size(), max_index, structure);
+    auto place = [&](std::uint32_t local) { return local == 0 ? slot : base + local - 1; };
+    nodes.resize(nodes.size() + s.nodes.size() - 1);
+    for (std::uint32_t i = 0; i < s.nodes.size(); ++i) {
+        const Node& n = s.nodes[i];
+        nodes[place(i)] = n.is_leaf() ? n.with_index(first_index + n.first()) : n.with_index(place(n.children()));
+    }
+}
+
+}  // namespace cellrt::detail

@@ -1,0 +1,184 @@
+// Pieces every single-ray traversal kernel shares (kd-tree, BIH; direct memory or the local-store
+// model): the prepared ray and its robustness margin, the two queries (closest hit, any hit), the work
+// counters, direct memory access, and the batch loop that turns the accelerator boundary's calls into
+// kernel calls with one dispatch per batch.
+//
+// Robustness. A structure only decides which triangles to test; hits are accepted by the hit rule
+// alone (ray.hpp), never by a cell's interval. Every decision that could skip a triangle is made
+// conservative by a margin `m` in ray parameter t: a cell is visited when the ray passes within m of
+// it, and a cell is skipped after a hit only when it starts more than m beyond the best t. m bounds
+// the rounding error of both a plane distance and the watertight test's t for points inside the scene
+// box: it is a fixed fraction of the largest distance from the origin to the box, in units of t.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/box.hpp"
+#include "cellrt/ray.hpp"
+#include "cellrt/triangle.hpp"
+
+namespace cellrt::detail {
+
+// Relative size of the margin: 2^-16 of the scene's extent as seen from the origin. The errors it
+// covers are a few units in the last place (2^-24) of that extent.
+inline constexpr float kMarginScale = 1.f / 65536.f;
+
+// min/max that keep the first operand when the second is NaN (a ray lying exactly in a plane gives
+// 0 * inf = NaN for the plane's distance, and then the plane must not cut the interval).
+inline float min_keep(float kept, float x) { return x < kept ? x : kept; }
+inline float max_keep(float kept, float x) { return x > kept ? x : kept; }
+
+struct TraversalRay {
+    Vec3 org, dir, inv_dir;
+    std::uint32_t dir_neg[3];  // 1 where the direction's sign bit is set (-0 included): the near child index
+    float tnear, tfar;
+    float margin;
+    WatertightRay watertight;
+
+    TraversalRay(const Ray& r, const Box3& scene_box)
+        : org(r.org), dir(r.dir), tnear(r.tnear), tfar(r.tfar), watertight(r) {
+        for (int a = 0; a < 3; ++a) {
+            inv_dir[a] = 1.f / dir[a];
+            dir_neg[a] = std::signbit(dir[a]) ? 1u : 0u;
+        }
+        const Vec3 reach = max(abs(scene_box.lo - org), abs(scene_box.hi - org));
+        margin = kMarginScale * length(reach) / length(dir);
+    }
+
+    Vec3 at(float t) const { return org + dir * t; }
+
+    // The ray's interval [tnear, tfar] clipped to `box`, both widened by the margin. False when empty.
+    // A slab the ray lies in exactly (origin on its face, zero direction on its axis) gives NaN and
+    // does not cut the interval.
+    bool clip(const Box3& box, float& tmin, float& tmax) const {
+        tmin = tnear - margin;
+        tmax = tfar + margin;
+        for (int a = 0; a < 3; ++a) {
+            const float t0 = (box.lo[a] - org[a]) * inv_dir[a];
+            const float t1 = (box.hi[a] - org[a]) * inv_dir[a];
+            const float enter = dir_neg[a] ? t1 : t0, leave = dir_neg[a] ? t0 : t1;
+            tmin = max_keep(tmin, enter - margin);
+            tmax = min_keep(tmax, leave + margin);
+        }
+        return tmin <= tmax;
+    }
+};
+
+// Work counters: the kernels call these on every node, leaf and triangle; NoCounters compiles them away.
+struct NoCounters {
+    void node() {}
+    void leaf() {}
+    void triangle() {}
+};
+
+struct WorkCounters {
+    TraversalCounters& sum;
+    void node() { ++sum.nodes; }
+    void leaf() { ++sum.leaves; }
+    void triangle() { ++sum.triangles; }
+};
+
+// Closest hit under the hit rule. Cells starting after best.t + margin cannot hold the answer.
+struct ClosestHit {
+    static constexpr bool kAnyHit = false;
+    Hit best;
+    float tnear;
+    float margin;
+
+    explicit ClosestHit(const TraversalRay& r) : best{r.tfar, kNoHit, 0.f, 0.f}, tnear(r.tnear), margin(r.margin) {}
+
+    float cull_t() const { return best.t + margin; }
+    // Tests one triangle; `prim` gives its index in the scene (read only for a candidate). Returns
+    // false: a closest-hit query never ends early.
+    template <class Prim>
+    bool test(const WatertightRay& r, const Triangle& tri, Prim&& prim) {
+        intersect_closest(r, tnear, tri, prim, best);
+        return false;
+    }
+    Hit result() const { return best.is_hit() ? best : Hit{}; }
+};
+
+// Any hit: the first triangle with tnear <= t <= tfar ends the query.
+struct AnyHit {
+    static constexpr bool kAnyHit = true;
+    float tnear, tfar;
+    float cull;
+
+    explicit AnyHit(const TraversalRay& r) : tnear(r.tnear), tfar(r.tfar), cull(r.tfar + r.margin) {}
+
+    float cull_t() const { return cull; }
+    template <class Prim>
+    bool test(const WatertightRay& r, const Triangle& tri, Prim&&) {
+        return intersect_any(r, tnear, tfar, tri);
+    }
+};
+
+// Direct memory access: the kernels read nodes, leaf indices and triangles through a memory policy so
+// that the local-store model can run the very same kernels. References returned by a policy are valid
+// until its next access; kernels copy nodes. touch_node() announces a node that will be read later
+// (the study's asynchronous access); directly it is a no-op.
+template <class Node>
+struct DirectMemory {
+    const Node* nodes;
+    const std::uint32_t* indices;
+    const Triangle* triangles;
+
+    const Node& node(std::uint32_t i) const { return nodes[i]; }
+    void touch_node(std::uint32_t) const {}
+    std::uint32_t index(std::uint32_t i) const { return indices[i]; }
+    const Triangle& triangle(std::uint32_t i) const { return triangles[i]; }
+};
+
+// The batch loops behind Accelerator::intersect/occluded: one branch on the counters per batch, then
+// `kernel(ray, query, counters)` for every valid ray. Invalid rays (ray.hpp) hit nothing.
+template <class Kernel>
+void closest_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters,
+                  Kernel&& kernel) {
+    auto loop = [&](auto& count) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            if (!is_valid(rays[i])) {
+                hits[i] = Hit{};
+                continue;
+            }
+            const TraversalRay r(rays[i], scene_box);
+            ClosestHit q(r);
+            kernel(r, q, count);
+            hits[i] = q.result();
+        }
+    };
+    if (counters) {
+        WorkCounters count{*counters};
+        loop(count);
+        counters->rays += rays.size();
+    } else {
+        NoCounters count;
+        loop(count);
+    }
+}
+
+template <class Kernel>
+void any_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+              TraversalCounters* counters, Kernel&& kernel) {
+    auto loop = [&](auto& count) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            occluded[i] = 0;
+            if (!is_valid(rays[i])) continue;
+            const TraversalRay r(rays[i], scene_box);
+            AnyHit q(r);
+            occluded[i] = kernel(r, q, count) ? 1 : 0;
+        }
+    };
+    if (counters) {
+        WorkCounters count{*counters};
+        loop(count);
+        counters->rays += rays.size();
+    } else {
+        NoCounters count;
+        loop(count);
+    }
+}
+
+}  // namespace cellrt::detail

@@ -1,0 +1,73 @@
+#include "bih_accel.hpp"
+
+#include "bih_traversal.hpp"
+#include "cellrt/timer.hpp"
+
+namespace cellrt::detail {
+namespace {
+
+BihBuildParams read_params(const AccelConfig& config) {
+    ParamReader in(config, "bih");
+    BihBuildParams p;
+    p.leaf_size = in.get_int("leaf_size", p.leaf_size, 1, 1 << 20);
+    p.max_depth = in.get_int("max_depth", p.max_depth, 1, kBihMaxDepth);
+    p.empty_cut = in.get_number("empty_cut", p.empty_cut, 0.0, 1.0);
+    p.threads = config.threads;
+    in.finish();
+    return p;
+}
+
+class BihAccelerator final : public Accelerator {
+public:
+    BihAccelerator(std::span<const Triangle> triangles, const BihBuildParams& params, BihTraversal traversal)
+        : params_(params), traversal_(traversal) {
+        Timer timer;
+        tree_ = build_bih(triangles, params);
+        build_seconds_ = timer.seconds();
+    }
+
+    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        DirectMemory<BihNode> mem = memory();
+        with_bih_kernel(traversal_, [&](auto kernel) {
+            closest_hits(tree_.bounds, rays, hits, counters,
+                         [&](const TraversalRay& r, auto& q, auto& c) { return kernel(tree_, mem, r, q, c); });
+        });
+    }
+
+    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                  TraversalCounters* counters) const override {
+        DirectMemory<BihNode> mem = memory();
+        with_bih_kernel(traversal_, [&](auto kernel) {
+            any_hits(tree_.bounds, rays, occluded, counters,
+                     [&](const TraversalRay& r, auto& q, auto& c) { return kernel(tree_, mem, r, q, c); });
+        });
+    }
+
+    AccelStats stats() const override {
+        AccelStats s{"bih", build_seconds_,
+                     tree_.nodes.size() * sizeof(BihNode) + tree_.triangles.size() * sizeof(Triangle) +
+                         tree_.prims.size() * sizeof(std::uint32_t),
+                     {{"traversal", traversal_ == BihTraversal::branched ? "branched" : "branchless"}}};
+        for (auto& f : bih_report(tree_, params_)) s.figures.push_back(std::move(f));
+        return s;
+    }
+
+private:
+    DirectMemory<BihNode> memory() const { return {tree_.nodes.data(), tree_.prims.data(), tree_.triangles.data()}; }
+
+    BihBuildParams params_;
+    BihTraversal traversal_;
+    BihTree tree_;
+    double build_seconds_ = 0.0;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> make_bih(std::span<const Triangle> triangles, const AccelConfig& config) {
+    const BihBuildParams params = read_params(config);
+    const std::string t = traversal_or_default(config, {"branchless", "branched"}, "bih");
+    return std::make_unique<BihAccelerator>(triangles, params,
+                                            t == "branched" ? BihTraversal::branched : BihTraversal::branchless);
+}
+
+}  // namespace cellrt::detail

@@ -1,0 +1,268 @@
+// BIH builder (Wächter & Keller 2006, section 2.2).
+//
+// The split candidate comes from the global heuristic: a grid cell that starts as the scene box and
+// is only ever halved on its own longest axis; the candidate plane is its midpoint, whatever the
+// node's box. Triangles are partitioned in place by the centre of their box; the left clip plane is
+// the largest coordinate of the left triangles, the right one the smallest of the right triangles.
+// When every triangle falls on one side, the grid cell is halved towards them and the split retried
+// without emitting a node, unless enough of the node is empty on the other side: then an empty-space
+// node is emitted, its empty child's plane at infinity. A node becomes a leaf at `leaf_size`
+// triangles, at `max_depth`, or when the grid cell can no longer be halved.
+//
+// Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
+// known in advance. Large ranges are built as parallel tasks (accel/subtree.hpp keeps the layout
+// independent of the thread count).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
+#include "accel/subtree.hpp"
+#include "bih_tree.hpp"
+
+namespace cellrt::detail {
+namespace {
+
+constexpr std::size_t kParallelMin = 4096;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+int longest_axis(const Box3& b) {
+    const Vec3 e = b.extent();
+    return e.x >= e.y ? (e.x >= e.z ? 0 : 2) : (e.y >= e.z ? 1 : 2);
+}
+
+struct Range {
+    std::uint32_t begin = 0, end = 0;
+    Box3 box;   // the node's clip box: where its triangles may lie
+    Box3 grid;  // the global heuristic's candidate cell
+    int depth = 0;
+    std::uint32_t size() const { return end - begin; }
+};
+
+class BihBuilder {
+public:
+    BihBuilder(std::span<const Triangle> tris, const BihBuildParams& p) : tris_(tris), p_(p) {
+        boxes_.reserve(tris.size());
+        centres_.reserve(tris.size());
+        for (const Triangle& t : tris) {
+            boxes_.push_back(t.bounds());
+            centres_.push_back(boxes_.back().center());
+        }
+        order_.resize(tris.size());
+        for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    }
+
+    BihTree build() {
+        BihTree tree;
+        Range root{0, static_cast<std::uint32_t>(tris_.size()), {}, {}, 0};
+        for (const Box3& b : boxes_) root.box.extend(b);
+        if (tris_.empty()) root.box = Box3{Vec3(0.f), Vec3(0.f)};
+        root.grid = root.box;
+        tree.bounds = root.box;
+        std::unique_ptr<Subtree<BihNode>> top;
+        auto run = [&] { top = subtree(root); };
+        if (p_.threads == 1) {
+            run();
+        } else {
+            tbb::task_arena arena(build_concurrency(p_.threads));
+            arena.execute(run);
+        }
+        tree.nodes = {BihNode{}, BihNode::leaf(0, 0)};
+        std::vector<std::uint32_t> no_indices;
+        flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
+        tree.triangles.reserve(tris_.size());
+        for (const std::uint32_t i : order_) tree.triangles.push_back(tris_[i]);
+        tree.prims = std::move(order_);
+        return tree;
+    }
+
+private:
+    enum class Kind { leaf, split, cut };
+    struct Decision {
+        Kind kind = Kind::leaf;
+        int axis = 0;
+        float left_clip = 0.f, right_clip = 0.f;
+        Range left, right;  // split: both; cut: the occupied one only (the other child is empty)
+        bool cut_keeps_left = true;
+    };
+
+    Decision decide(Range r) {
+        Decision d;
+        if (r.size() <= static_cast<std::uint32_t>(p_.leaf_size) || r.depth >= p_.max_depth) return d;
+        Box3 centres, objects;
+        for (std::uint32_t i = r.begin; i < r.end; ++i) {
+            centres.extend(centres_[order_[i]]);
+            objects.extend(boxes_[order_[i]]);
+        }
+        for (;;) {
+            const int a = longest_axis(r.grid);
+            const float split = 0.5f * (r.grid.lo[a] + r.grid.hi[a]);
+            if (!(r.grid.lo[a] < split && split < r.grid.hi[a])) return d;  // the cell cannot be halved further
+            const float width = r.box.hi[a] - r.box.lo[a];
+            if (centres.hi[a] <= split) {  // all left: cut the empty right part, or halve the cell
+                if (r.box.hi[a] - objects.hi[a] > static_cast<float>(p_.empty_cut) * width)
+                    return cut(r, a, objects.hi[a], -kInf, true);
+                r.grid.hi[a] = split;
+                continue;
+            }
+            if (centres.lo[a] > split) {  // all right
+                if (objects.lo[a] - r.box.lo[a] > static_cast<float>(p_.empty_cut) * width)
+                    return cut(r, a, kInf, objects.lo[a], false);
+                r.grid.lo[a] = split;
+                continue;
+            }
+            const auto mid_it = std::partition(order_.begin() + r.begin, order_.begin() + r.end,
+                                               [&](std::uint32_t t) { return centres_[t][a] <= split; });
+            const auto mid = static_cast<std::uint32_t>(mid_it - order_.begin());
+            d.kind = Kind::split;
+            d.axis = a;
+            d.left_clip = -kInf;
+            d.right_clip = kInf;
+            for (std::uint32_t i = r.begin; i < mid; ++i) d.left_clip = std::max(d.left_clip, boxes_[order_[i]].hi[a]);
+            for (std::uint32_t i = mid; i < r.end; ++i) d.right_clip = std::min(d.right_clip, boxes_[order_[i]].lo[a]);
+            d.left = d.right = r;
+            d.left.end = mid;
+            d.right.begin = mid;
+            d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
+            d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
+            d.left.grid.hi[a] = split;
+            d.right.grid.lo[a] = split;
+            d.left.depth = d.right.depth = r.depth + 1;
+            return d;
+        }
+    }
+
+    // An empty-space node: every triangle in one child, bounded by `left_clip`/`right_clip`; the
+    // other child is an empty leaf whose plane at infinity no ray reaches.
+    static Decision cut(const Range& r, int a, float left_clip, float right_clip, bool keeps_left) {
+        Decision d;
+        d.kind = Kind::cut;
+        d.axis = a;
+        d.left_clip = left_clip;
+        d.right_clip = right_clip;
+        d.cut_keeps_left = keeps_left;
+        d.left = r;
+        d.left.depth = r.depth + 1;
+        if (keeps_left) d.left.box.hi[a] = left_clip;
+        else d.left.box.lo[a] = right_clip;
+        return d;
+    }
+
+    std::unique_ptr<Subtree<BihNode>> subtree(const Range& r) {
+        auto out = std::make_unique<Subtree<BihNode>>();
+        out->nodes.resize(1);
+        if (r.size() < kParallelMin || p_.threads == 1) {
+            sequential(r, *out, 0);
+            return out;
+        }
+        const Decision d = decide(r);
+        if (d.kind != Kind::split) {  // leaves and cuts of large ranges: continue in this task
+            sequential_from(d, r, *out, 0);
+            return out;
+        }
+        out->nodes[0] = BihNode::inner(d.axis, d.left_clip, d.right_clip, 0);
+        tbb::task_group group;
+        group.run([&] { out->left = subtree(d.left); });
+        out->right = subtree(d.right);
+        group.wait();
+        return out;
+    }
+
+    void sequential(const Range& r, Subtree<BihNode>& out, std::uint32_t slot) { sequential_from(decide(r), r, out, slot); }
+
+    void sequential_from(const Decision& d, const Range& r, Subtree<BihNode>& out, std::uint32_t slot) {
+        if (d.kind == Kind::leaf) {
+            out.nodes[slot] = BihNode::leaf(r.begin, r.size());
+            return;
+        }
+        const auto pair = static_cast<std::uint32_t>(out.nodes.size());
+        out.nodes.resize(out.nodes.size() + 2);
+        out.nodes[slot] = BihNode::inner(d.axis, d.left_clip, d.right_clip, pair);
+        if (d.kind == Kind::split) {
+            sequential(d.left, out, pair);
+            sequential(d.right, out, pair + 1);
+            return;
+        }
+        out.nodes[d.cut_keeps_left ? pair + 1 : pair] = BihNode::leaf(0, 0);
+        sequential(d.left, out, d.cut_keeps_left ? pair : pair + 1);
+    }
+
+    std::span<const Triangle> tris_;
+    const BihBuildParams& p_;
+    std::vector<Box3> boxes_;
+    std::vector<Vec3> centres_;
+    std::vector<std::uint32_t> order_;
+};
+
+struct Totals {
+    std::size_t inner = 0, leaves = 0, empty_leaves = 0, cuts = 0, triangles = 0, depth_sum = 0;
+    int max_depth = 0;
+    double cost = 0.0;
+};
+
+double area(const Box3& b) {
+    if (b.is_empty()) return 0.0;
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return 2.0 * (x * y + y * z + z * x);
+}
+
+// Walks the hierarchy with each node's box (the parent's box cut by the node's clip plane).
+void walk(const BihTree& tree, std::uint32_t index, const Box3& box, int depth, Totals& t) {
+    const BihNode& n = tree.nodes[index];
+    t.max_depth = std::max(t.max_depth, depth);
+    if (n.is_leaf()) {
+        ++t.leaves;
+        t.triangles += n.count();
+        if (n.count() == 0) ++t.empty_leaves;
+        else t.depth_sum += static_cast<std::size_t>(depth);
+        t.cost += 20.0 * n.count() * area(box);  // the kd-tree's default costs, for comparison
+        return;
+    }
+    ++t.inner;
+    const int a = n.axis();
+    if (std::isinf(n.clip(0)) || std::isinf(n.clip(1))) ++t.cuts;
+    t.cost += 15.0 * area(box);
+    Box3 left = box, right = box;
+    left.hi[a] = std::min(left.hi[a], n.clip(0));
+    right.lo[a] = std::max(right.lo[a], n.clip(1));
+    walk(tree, n.children(), left, depth + 1, t);
+    walk(tree, n.children() + 1, right, depth + 1, t);
+}
+
+std::string fmt(const char* format, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
+}
+
+}  // namespace
+
+BihTree build_bih(std::span<const Triangle> triangles, const BihBuildParams& params) {
+    if (triangles.size() > BihNode::kMaxIndex) throw Error("BIH: at most 2^30 triangles are supported");
+    return BihBuilder(triangles, params).build();
+}
+
+std::vector<std::pair<std::string, std::string>> bih_report(const BihTree& tree, const BihBuildParams& params) {
+    Totals t;
+    walk(tree, 0, tree.bounds, 0, t);
+    const std::size_t full = t.leaves - t.empty_leaves;
+    const double root_area = area(tree.bounds);
+    return {
+        {"nodes", std::to_string(t.inner + t.leaves)},
+        {"inner nodes", std::to_string(t.inner)},
+        {"empty-space nodes", std::to_string(t.cuts)},
+        {"leaves", std::to_string(t.leaves)},
+        {"empty leaves", std::to_string(t.empty_leaves)},
+        {"depth limit", std::to_string(params.max_depth)},
+        {"max depth", std::to_string(t.max_depth)},
+        {"mean leaf depth", fmt("%.2f", full ? double(t.depth_sum) / double(full) : 0.0)},
+        {"tris per leaf", fmt("%.2f", full ? double(t.triangles) / double(full) : 0.0)},
+        {"SAH cost", fmt("%.2f", root_area > 0.0 ? t.cost / root_area : 0.0)},
+    };
+}
+
+}  // namespace cellrt::detail

@@ -1,0 +1,216 @@
+// kd-tree traversal kernels for single rays: Havran's TA_rec, the classic stack traversal and the
+// study's branchless variant. Each is one template over the query (closest or any hit), the memory
+// policy (direct, or the local-store model's software caches) and the work counters; all three visit
+// cells conservatively (traversal.hpp) and so return exactly the hits of brute force.
+//
+// Memory: every kernel touches an inner node's child pair (siblings share a line) as soon as it reads
+// the node, and reads a node only when it goes there: the study's asynchronous access, free when
+// memory is direct.
+#pragma once
+
+#include "accel/traversal.hpp"
+#include "kd_tree.hpp"
+
+namespace cellrt::detail {
+
+// Tests the triangles of a leaf; true when an any-hit query is answered.
+template <class Query, class Memory, class Counters>
+bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    c.leaf();
+    const std::uint32_t end = leaf.first() + leaf.count();
+    for (std::uint32_t k = leaf.first(); k < end; ++k) {
+        const std::uint32_t prim = mem.index(k);
+        c.triangle();
+        if (q.test(r.watertight, mem.triangle(prim), prim)) return true;
+    }
+    return false;
+}
+
+// Classic stack traversal (pbrt's, Wald's): entries (node, tmin, tmax); the near child is the one on
+// the side the direction points from, the far one is pushed when the ray reaches it.
+template <class Query, class Memory, class Counters>
+bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    struct Entry {
+        std::uint32_t node;
+        float tmin, tmax;
+    };
+    float tmin, tmax;
+    if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    Entry stack[kKdMaxDepth + 1];
+    int sp = 0;
+    std::uint32_t index = 0;
+    for (;;) {
+        KdNode n = mem.node(index);
+        while (!n.is_leaf()) {
+            c.node();
+            mem.touch_node(n.children());
+            const int a = n.axis();
+            const float t = (n.split() - r.org[a]) * r.inv_dir[a];
+            const std::uint32_t near = n.children() + r.dir_neg[a], far = n.children() + (r.dir_neg[a] ^ 1u);
+            // NaN t (the ray lies in the plane) passes both tests: both children are visited.
+            const bool near_ok = !(tmin > t + r.margin), far_ok = !(t - r.margin > tmax);
+            if (near_ok) {
+                if (far_ok) stack[sp++] = {far, max_keep(tmin, t - r.margin), tmax};
+                tmax = min_keep(tmax, t + r.margin);
+                index = near;
+            } else {
+                tmin = max_keep(tmin, t - r.margin);
+                index = far;
+            }
+            n = mem.node(index);
+        }
+        if (kd_leaf(n, mem, r, q, c)) return true;
+        do {
+            if (sp == 0) return false;
+            --sp;
+        } while (stack[sp].tmin > q.cull_t());
+        index = stack[sp].node;
+        tmin = stack[sp].tmin;
+        tmax = stack[sp].tmax;
+    }
+}
+
+// The study's branchless traversal (section 4.5, after Havran 2007): at an inner node both entries
+// are written, far first, and the stack pointer moves by the two comparison results; the next node
+// is then popped from the top. The only branch left in the inner loop is the loop's own.
+template <class Query, class Memory, class Counters>
+bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    struct Entry {
+        std::uint32_t node;
+        float tmin, tmax;
+    };
+    float tmin, tmax;
+    if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    Entry stack[kKdMaxDepth + 2];
+    int sp = 0;
+    std::uint32_t index = 0;
+    for (;;) {
+        KdNode n = mem.node(index);
+        while (!n.is_leaf()) {
+            c.node();
+            mem.touch_node(n.children());
+            const int a = n.axis();
+            const float t = (n.split() - r.org[a]) * r.inv_dir[a];
+            const std::uint32_t near = n.children() + r.dir_neg[a], far = near ^ 1u;
+            const bool near_ok = !(tmin > t + r.margin), far_ok = !(t - r.margin > tmax);
+            stack[sp] = {far, max_keep(tmin, t - r.margin), tmax};
+            sp += far_ok;
+            stack[sp] = {near, tmin, min_keep(tmax, t + r.margin)};
+            sp += near_ok;
+            --sp;
+            index = stack[sp].node;
+            tmin = stack[sp].tmin;
+            tmax = stack[sp].tmax;
+            n = mem.node(index);
+        }
+        if (kd_leaf(n, mem, r, q, c)) return true;
+        do {
+            if (sp == 0) return false;
+            --sp;
+        } while (stack[sp].tmin > q.cull_t());
+        index = stack[sp].node;
+        tmin = stack[sp].tmin;
+        tmax = stack[sp].tmax;
+    }
+}
+
+// Havran's TA_rec (thesis, appendix C, the "B" variant): the stack holds points on the ray, not
+// intervals. Each inner node is classified by comparing the coordinates of the current entry and exit
+// points with the split; only when the ray crosses the plane is its distance computed and a new
+// point pushed, which links to the exit point it replaces and names the far child that starts there.
+// A leaf's exit point is the next cell's entry. For robustness a point carries two positions: where
+// the near child is left (t + margin) and where the far child is entered (t - margin), and the
+// one-sided cases require both points to lie a coordinate margin clear of the plane.
+template <class Query, class Memory, class Counters>
+bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    constexpr std::uint32_t kNone = ~0u;
+    struct Point {
+        float t_exit, t_entry;  // as the exit of the near child / the entry of the far child
+        Vec3 exit, entry;
+        std::uint32_t far;      // the node that starts at this point (kNone: the ray's end)
+        int prev;               // the exit point of `far`
+    };
+    float tmin, tmax;
+    if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
+    const float reach = r.margin * length(r.dir);
+    const Vec3 o = abs(r.org);
+    const float tol = reach + kMarginScale * std::max(o.x, std::max(o.y, o.z));
+    Point stack[kKdMaxDepth + 3];
+    int en = 0, ex = 1;
+    stack[en].t_entry = tmin;
+    stack[en].entry = r.at(tmin);
+    stack[ex].t_exit = tmax;
+    stack[ex].exit = r.at(tmax);
+    stack[ex].far = kNone;
+    stack[ex].prev = -1;
+    std::uint32_t index = 0;
+    for (;;) {
+        KdNode n = mem.node(index);
+        while (!n.is_leaf()) {
+            c.node();
+            mem.touch_node(n.children());
+            const int a = n.axis();
+            const float s = n.split();
+            const float p0 = stack[en].entry[a], p1 = stack[ex].exit[a];
+            const bool left_ok = std::min(p0, p1) <= s + tol, right_ok = std::max(p0, p1) >= s - tol;
+            if (!right_ok) {
+                index = n.children();
+            } else if (!left_ok) {
+                index = n.children() + 1;
+            } else {
+                // The ray crosses (or runs along) the plane: near child first, far child from the new point.
+                const float t = (s - r.org[a]) * r.inv_dir[a];
+                const std::uint32_t near = n.children() + r.dir_neg[a];
+                int k = ex + 1;
+                if (k == en) ++k;
+                Point& pt = stack[k];
+                pt.t_exit = min_keep(stack[ex].t_exit, t + r.margin);
+                pt.t_entry = max_keep(stack[en].t_entry, t - r.margin);
+                pt.exit = r.at(pt.t_exit);
+                pt.entry = r.at(pt.t_entry);
+                pt.far = near ^ 1u;
+                pt.prev = ex;
+                ex = k;
+                index = near;
+            }
+            n = mem.node(index);
+        }
+        if (kd_leaf(n, mem, r, q, c)) return true;
+        // Continue with the node that starts at the leaf's exit point, unless it starts past the answer.
+        for (;;) {
+            if (stack[ex].far == kNone) return false;
+            en = ex;
+            ex = stack[en].prev;
+            if (!(stack[en].t_entry > q.cull_t())) break;
+        }
+        index = stack[en].far;
+    }
+}
+
+}  // namespace cellrt::detail
+
+namespace cellrt::detail {
+
+// The traversals by name, as function objects, so that callers choose one per batch, not per ray.
+enum class KdTraversal { rec, branched, branchless };
+
+template <class Fn>
+decltype(auto) with_kd_kernel(KdTraversal t, Fn&& fn) {
+    auto rec = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
+        return kd_traverse_rec(tree, mem, r, q, c);
+    };
+    auto branched = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
+        return kd_traverse_branched(tree, mem, r, q, c);
+    };
+    auto branchless = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
+        return kd_traverse_branchless(tree, mem, r, q, c);
+    };
+    switch (t) {
+        case KdTraversal::rec: return fn(rec);
+        case KdTraversal::branched: return fn(branched);
+        default: return fn(branchless);
+    }
+}
+
+}  // namespace cellrt::detail

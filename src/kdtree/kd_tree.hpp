@@ -1,0 +1,70 @@
+// The SAH kd-tree: build parameters, the built tree and its report.
+//
+// Build (kd_build.cpp): the surface area heuristic with min-max binning near the root (Shevtsov,
+// Soupikov, Kapustin, "Highly Parallel Fast KD-tree Construction for Interactive Ray Tracing of
+// Dynamic Scenes", 2007) and the exact O(N log N) event sweep below (Wald & Havran, "On building fast
+// kd-Trees for Ray Tracing, and on doing that in O(N log N)", 2006), with perfect splits.
+// Traversals (kd_traversal.hpp): Havran's TA_rec, the classic stack traversal and the study's
+// branchless variant.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cellrt/box.hpp"
+#include "cellrt/triangle.hpp"
+#include "kd_node.hpp"
+
+namespace cellrt::detail {
+
+// Hard bound on the depth of any kd-tree; traversal stacks are sized by it.
+inline constexpr int kKdMaxDepth = 60;
+
+enum class KdBuildMethod { hybrid, sweep, binned };
+
+// Build parameters. Names are those of `-P NAME=VALUE`; defaults and ranges are documented in
+// docs/KDTREE.md and validated in kd_accel.cpp.
+struct KdBuildParams {
+    // Cost of one traversal step and of one triangle test (Wald & Havran's constants).
+    double traversal_cost = 15.0;
+    double intersection_cost = 20.0;
+    // A split with an empty side costs (1 - empty_bonus) times its SAH value (Mitsuba: 0.1; Wald &
+    // Havran's lambda = 0.8 is empty_bonus = 0.2).
+    double empty_bonus = 0.1;
+    // Depth limit; 0 chooses 8 + 1.3 log2 N, capped at kKdMaxDepth.
+    int max_depth = 0;
+    // A node with at most this many triangles is always a leaf (Mitsuba's stopPrims).
+    int leaf_size = 6;
+    KdBuildMethod method = KdBuildMethod::hybrid;
+    // Hybrid: nodes with more references than this are split by min-max binning, the rest by the sweep.
+    int sweep_below = 4096;
+    int bins = 128;
+    // Clip straddling triangles to each child cell, so that child boxes are tight.
+    bool perfect_splits = true;
+    // Replace a built subtree that is no cheaper (by the SAH) than a single leaf by that leaf.
+    bool retract = true;
+    // Bad-refinement rule: splits that cost more than a leaf are allowed this many times on a path.
+    int max_bad_refines = 3;
+    // Build threads; 0: all hardware threads. The tree is the same for every value.
+    unsigned threads = 0;
+
+    int depth_limit(std::size_t triangles) const;
+};
+
+struct KdTree {
+    // nodes[0] is the root and nodes[1] padding, so that child pairs start at even indices.
+    std::vector<KdNode> nodes;
+    std::vector<std::uint32_t> indices;  // leaf triangle lists, ascending within a leaf
+    Box3 bounds;                         // the root cell: the scene's bounding box
+    std::size_t triangle_count = 0;
+};
+
+KdTree build_kdtree(std::span<const Triangle> triangles, const KdBuildParams& params);
+
+// Figures of the build report, in print order (Mitsuba's build statistics).
+std::vector<std::pair<std::string, std::string>> kd_report(const KdTree& tree, const KdBuildParams& params);
+
+}  // namespace cellrt::detail

@@ -1,0 +1,88 @@
+// The scenes every acceleration structure is held to: built-in scenes, the shared real scenes, and a
+// catalogue of degenerate inputs (after Embree's verify suite).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cellrt/builtin.hpp"
+#include "ray_suite.hpp"
+#include "scenes.hpp"
+
+namespace cellrt::test {
+
+inline std::vector<std::string> structure_scene_names() {
+    return {"builtin:spheres?tris=2000", "builtin:city?tris=20000", "builtin:forest?tris=20000",
+            "teapot", "bunny", "sponza", "sibenik"};
+}
+
+// The scene for a name of structure_scene_names(); nullptr when a shared scene is absent.
+inline const Scene* structure_scene(const std::string& name) {
+    if (name.rfind("builtin:", 0) == 0) return &cached_scene(name);
+    const std::string path = shared_view(name);
+    return path.empty() ? nullptr : &cached_scene(path);
+}
+
+// A GoogleTest-friendly name: letters and digits only.
+inline std::string test_name(const std::string& name) {
+    std::string out;
+    for (char c : name.substr(0, name.find('?'))) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    return out;
+}
+
+inline RaySuiteOptions small_suite() {
+    RaySuiteOptions o;
+    o.random = o.inside = o.vertices = o.edges = 4000;
+    o.axis_parallel = 1200;
+    o.planes = 3000;
+    return o;
+}
+
+inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_scenes() {
+    std::vector<std::pair<std::string, std::vector<Triangle>>> out;
+    const Triangle unit{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+    out.push_back({"one triangle", {unit}});
+
+    std::vector<Triangle> grid;  // coplanar, axis-aligned: a 20 x 20 grid of quads in y = 0
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) {
+            const float x = float(i), z = float(j);
+            grid.push_back({{x, 0.f, z}, {x + 1.f, 0.f, z}, {x + 1.f, 0.f, z + 1.f}});
+            grid.push_back({{x, 0.f, z}, {x + 1.f, 0.f, z + 1.f}, {x, 0.f, z + 1.f}});
+        }
+    out.push_back({"coplanar grid", grid});
+
+    std::vector<Triangle> flat;  // flat in z: partly overlapping random triangles in the plane z = 1.5
+    std::uint32_t state = 12345;
+    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    for (int i = 0; i < 500; ++i) {
+        const float x = next() * 10, y = next() * 10;
+        flat.push_back({{x, y, 1.5f}, {x + next(), y + next(), 1.5f}, {x + next(), y - next(), 1.5f}});
+    }
+    out.push_back({"flat in z", flat});
+
+    out.push_back({"duplicates", std::vector<Triangle>(1000, unit)});
+
+    std::vector<Triangle> zero;  // zero-area triangles (points, lines, repeated vertices) among real ones
+    for (int i = 0; i < 300; ++i) {
+        const Vec3 p{next() * 4, next() * 4, next() * 4}, q{next() * 4, next() * 4, next() * 4};
+        zero.push_back({p, p, p});
+        zero.push_back({p, q, p});
+        zero.push_back({p, (p + q) * 0.5f, q});
+        zero.push_back({p, q, Vec3{next() * 4, next() * 4, next() * 4}});
+    }
+    out.push_back({"zero area", zero});
+
+    std::vector<Triangle> huge;  // tiny triangles near the origin and enormous ones far away
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 c{next() * 1e-3f, next() * 1e-3f, next() * 1e-3f};
+        huge.push_back({c, c + Vec3{1e-4f, 0.f, 0.f}, c + Vec3{0.f, 1e-4f, 1e-5f}});
+        const Vec3 f{next() * 1e12f, next() * 1e12f, next() * 1e12f};
+        huge.push_back({f, f + Vec3{1e11f, next() * 1e10f, 0.f}, f + Vec3{0.f, 1e11f, 1e11f}});
+    }
+    out.push_back({"huge coordinate range", huge});
+    return out;
+}
+
+}  // namespace cellrt::test

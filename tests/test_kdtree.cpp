@@ -1,0 +1,112 @@
+// The SAH kd-tree beyond the checks every structure faces (test_structures.cpp): every build variant
+// stays exact, rays lying in its own split planes, the same tree at any thread count, the build
+// report and parameter validation.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
+#include "kdtree/kd_tree.hpp"
+#include "ray_suite.hpp"
+#include "scenes.hpp"
+
+namespace cellrt {
+namespace {
+
+const std::vector<std::string> kTraversals = {"rec", "branched", "branchless"};
+
+AccelConfig kd(const std::string& traversal, std::map<std::string, std::string> params = {}) {
+    AccelConfig c{"kd", traversal};
+    c.params = std::move(params);
+    return c;
+}
+
+// Build variants must all stay exact: binning only, sweep only, no perfect splits, no retraction,
+// tiny leaves and a shallow depth limit.
+TEST(KdTree, BuildVariantsMatchBruteForce) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
+    const std::vector<std::map<std::string, std::string>> variants = {
+        {{"method", "binned"}, {"bins", "16"}},
+        {{"method", "sweep"}},
+        {{"perfect_splits", "false"}},
+        {{"retract", "false"}, {"leaf_size", "1"}},
+        {{"max_depth", "3"}},
+        {{"empty_bonus", "0.9"}, {"traversal_cost", "1"}, {"intersection_cost", "80"}},
+    };
+    for (const auto& params : variants)
+        for (const std::string& t : kTraversals) {
+            std::string what = "kd " + t;
+            for (const auto& [k, v] : params) what += " " + k + "=" + v;
+            test::expect_matches(*make_accelerator(scene.triangles, kd(t, params)), ref, what);
+        }
+}
+
+// Rays in, on and across the tree's own split planes: the places where a kd-tree decides which
+// side a ray is on, with +0 and -0 direction components along the split axis.
+TEST(KdTree, RaysInItsOwnSplitPlanes) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const detail::KdTree tree = detail::build_kdtree(scene.triangles, detail::KdBuildParams{});
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f), s(-1.f, 1.f);
+    const Box3 b = tree.bounds;
+    std::vector<Ray> rays;
+    for (std::size_t i = 0; i < tree.nodes.size() && rays.size() < 60000; i += 3) {
+        const detail::KdNode& n = tree.nodes[i];
+        if (n.is_leaf()) continue;
+        for (int k = 0; k < 4; ++k) {
+            Ray r;
+            for (int a = 0; a < 3; ++a) r.org[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * u(rng);
+            r.org[n.axis()] = n.split();
+            r.dir = normalize(Vec3{s(rng), s(rng), s(rng)});
+            if (k < 2) r.dir[n.axis()] = k == 0 ? 0.f : -0.f;  // lying in the plane
+            if (k == 3) r.org[n.axis()] = std::nextafter(n.split(), kInfinity);
+            if (!(r.dir == Vec3{})) rays.push_back(r);
+        }
+    }
+    const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
+    for (const std::string& t : kTraversals)
+        test::expect_matches(*make_accelerator(scene.triangles, kd(t)), ref, "kd " + t + " in split planes");
+}
+
+TEST(KdTree, SameTreeBytesAtAnyThreadCount) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=40000");
+    detail::KdBuildParams p;
+    p.threads = 1;
+    const detail::KdTree one = detail::build_kdtree(scene.triangles, p);
+    for (unsigned threads : {2u, 4u, 0u}) {
+        p.threads = threads;
+        const detail::KdTree many = detail::build_kdtree(scene.triangles, p);
+        ASSERT_EQ(one.nodes.size(), many.nodes.size()) << threads << " threads";
+        ASSERT_EQ(one.indices, many.indices) << threads << " threads";
+        EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::KdNode)), 0)
+            << threads << " threads";
+    }
+}
+
+TEST(KdTree, ReportsItsBuild) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const AccelStats s = make_accelerator(scene.triangles, kd(""))->stats();
+    EXPECT_EQ(s.name, "kd");
+    EXPECT_GT(s.memory_bytes, 0u);
+    std::map<std::string, std::string> f(s.figures.begin(), s.figures.end());
+    for (const char* key : {"nodes", "leaves", "empty leaves", "max depth", "mean leaf depth", "tris per leaf",
+                            "refs per tri", "SAH cost", "traversal"})
+        EXPECT_TRUE(f.count(key)) << key;
+    EXPECT_EQ(f["traversal"], "branchless");
+    EXPECT_GE(std::stod(f["refs per tri"]), 1.0);
+}
+
+TEST(KdTree, RejectsBadParameters) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+             {"traversal_cost", "-1"}, {"intersection_cost", "x"}, {"empty_bonus", "1"}, {"max_depth", "99"},
+             {"method", "octree"}, {"bins", "2"}, {"perfect_splits", "maybe"}, {"no_such", "1"}})
+        EXPECT_THROW(make_accelerator(scene.triangles, kd("", {{k, v}})), Error) << k << "=" << v;
+    EXPECT_THROW(make_accelerator(scene.triangles, kd("stackless")), Error);
+}
+
+}  // namespace
+}  // namespace cellrt
