@@ -1,0 +1,119 @@
+// The BIH beyond the checks every structure faces (test_structures.cpp): build variants stay exact,
+// rays in its own clip planes, no duplicated references, the same hierarchy at any thread count,
+// the build report and parameter validation.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+
+#include "bih/bih_tree.hpp"
+#include "cellrt/error.hpp"
+#include "ray_suite.hpp"
+#include "scenes.hpp"
+
+namespace cellrt {
+namespace {
+
+const std::vector<std::string> kTraversals = {"branched", "branchless"};
+
+AccelConfig bih(const std::string& traversal, std::map<std::string, std::string> params = {}) {
+    AccelConfig c{"bih", traversal};
+    c.params = std::move(params);
+    return c;
+}
+
+TEST(Bih, BuildVariantsMatchBruteForce) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
+    const std::vector<std::map<std::string, std::string>> variants = {
+        {{"leaf_size", "1"}}, {{"leaf_size", "16"}}, {{"empty_cut", "1"}}, {{"empty_cut", "0"}}, {{"max_depth", "4"}}};
+    for (const auto& params : variants)
+        for (const std::string& t : kTraversals) {
+            std::string what = "bih " + t;
+            for (const auto& [k, v] : params) what += " " + k + "=" + v;
+            test::expect_matches(*make_accelerator(scene.triangles, bih(t, params)), ref, what);
+        }
+}
+
+// Rays lying in, starting on and running just beside the hierarchy's own clip planes.
+TEST(Bih, RaysInItsOwnClipPlanes) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const detail::BihTree tree = detail::build_bih(scene.triangles, detail::BihBuildParams{});
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.f, 1.f), s(-1.f, 1.f);
+    const Box3 b = tree.bounds;
+    std::vector<Ray> rays;
+    for (const detail::BihNode& n : tree.nodes) {
+        if (n.is_leaf() || rays.size() > 60000) continue;
+        for (std::uint32_t side = 0; side < 2; ++side) {
+            if (std::isinf(n.clip(side))) continue;
+            for (int k = 0; k < 3; ++k) {
+                Ray r;
+                for (int a = 0; a < 3; ++a) r.org[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * u(rng);
+                r.org[n.axis()] = k == 2 ? std::nextafter(n.clip(side), -kInfinity) : n.clip(side);
+                r.dir = normalize(Vec3{s(rng), s(rng), s(rng)});
+                if (k < 2) r.dir[n.axis()] = k == 0 ? 0.f : -0.f;
+                rays.push_back(r);
+            }
+        }
+    }
+    const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
+    for (const std::string& t : kTraversals)
+        test::expect_matches(*make_accelerator(scene.triangles, bih(t)), ref, "bih " + t + " in clip planes");
+}
+
+// Triangles are reordered, not duplicated: every triangle is in exactly one leaf, and the leaves'
+// ranges tile the array.
+TEST(Bih, LeavesPartitionTheTriangles) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const detail::BihTree tree = detail::build_bih(scene.triangles, detail::BihBuildParams{});
+    ASSERT_EQ(tree.triangles.size(), scene.triangles.size());
+    std::vector<std::uint32_t> prims = tree.prims;
+    std::sort(prims.begin(), prims.end());
+    for (std::uint32_t i = 0; i < prims.size(); ++i) ASSERT_EQ(prims[i], i);
+    for (std::size_t i = 0; i < tree.triangles.size(); ++i) ASSERT_EQ(tree.triangles[i], scene.triangles[tree.prims[i]]);
+    std::vector<int> covered(tree.triangles.size(), 0);
+    for (std::size_t i = 2; i < tree.nodes.size(); ++i)
+        if (tree.nodes[i].is_leaf())
+            for (std::uint32_t k = 0; k < tree.nodes[i].count(); ++k) ++covered[tree.nodes[i].first() + k];
+    if (tree.nodes[0].is_leaf()) for (int& c : covered) ++c;
+    EXPECT_TRUE(std::all_of(covered.begin(), covered.end(), [](int c) { return c == 1; }));
+}
+
+TEST(Bih, SameHierarchyBytesAtAnyThreadCount) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=40000");
+    detail::BihBuildParams p;
+    p.threads = 1;
+    const detail::BihTree one = detail::build_bih(scene.triangles, p);
+    for (unsigned threads : {2u, 0u}) {
+        p.threads = threads;
+        const detail::BihTree many = detail::build_bih(scene.triangles, p);
+        ASSERT_EQ(one.nodes.size(), many.nodes.size()) << threads << " threads";
+        EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::BihNode)), 0);
+        EXPECT_EQ(one.prims, many.prims);
+    }
+}
+
+TEST(Bih, ReportsItsBuild) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const AccelStats s = make_accelerator(scene.triangles, bih(""))->stats();
+    EXPECT_EQ(s.name, "bih");
+    std::map<std::string, std::string> f(s.figures.begin(), s.figures.end());
+    for (const char* key : {"nodes", "leaves", "empty leaves", "empty-space nodes", "max depth", "mean leaf depth",
+                            "tris per leaf", "SAH cost", "traversal"})
+        EXPECT_TRUE(f.count(key)) << key;
+    // Memory is known in advance: nodes, the reordered triangles and their scene indices.
+    EXPECT_GE(s.memory_bytes, scene.triangles.size() * (sizeof(Triangle) + 4));
+}
+
+TEST(Bih, RejectsBadParameters) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+             {"leaf_size", "0"}, {"max_depth", "65"}, {"empty_cut", "1.5"}, {"bins", "8"}})
+        EXPECT_THROW(make_accelerator(scene.triangles, bih("", {{k, v}})), Error) << k << "=" << v;
+    EXPECT_THROW(make_accelerator(scene.triangles, bih("rec")), Error);
+}
+
+}  // namespace
+}  // namespace cellrt
