@@ -105,13 +105,13 @@ private:
             const float width = r.box.hi[a] - r.box.lo[a];
             if (centres.hi[a] <= split) {  // all left: cut the empty right part, or halve the cell
                 if (r.box.hi[a] - objects.hi[a] > static_cast<float>(p_.empty_cut) * width)
-                    return cut(r, a, objects.hi[a], -kInf, true);
+                    return cut(r, a, objects.hi[a], kInf, true);
                 r.grid.hi[a] = split;
                 continue;
             }
             if (centres.lo[a] > split) {  // all right
                 if (objects.lo[a] - r.box.lo[a] > static_cast<float>(p_.empty_cut) * width)
-                    return cut(r, a, kInf, objects.lo[a], false);
+                    return cut(r, a, -kInf, objects.lo[a], false);
                 r.grid.lo[a] = split;
                 continue;
             }
