@@ -36,6 +36,13 @@ struct RenderStats {
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,
              RenderStats* stats = nullptr);
 
+// The point a hit names and the triangle's geometric normal there, turned to face the side the ray
+// came from.
+struct SurfacePoint {
+    Vec3 position, normal;
+};
+SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit);
+
 // Shadow-ray origin for a hit point p on a surface with geometric normal n (facing the side the
 // ray came from): p pushed off the surface by a few ulps of its own magnitude, so the ray cannot
 // hit the surface it starts on (Wächter & Binder, "A Fast and Robust Method for Avoiding

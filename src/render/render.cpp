@@ -47,12 +47,9 @@ void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCam
             colours[i] = sky(w.rays[i].dir);
             continue;
         }
-        const Triangle& tri = scene.triangles[h.prim];
-        Vec3 n = normalize(tri.geometric_normal());
-        if (dot(n, w.rays[i].dir) > 0.f) n = -n;  // face the viewer
-        w.normals[i] = n;
-        const Vec3 p = tri.v0 * (1.f - h.u - h.v) + tri.v1 * h.u + tri.v2 * h.v;
-        w.shadow_rays.push_back(shadow_ray(p, n, scene.light.position));
+        const SurfacePoint sp = surface_point(scene.triangles[h.prim], w.rays[i], h);
+        w.normals[i] = sp.normal;
+        w.shadow_rays.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
         w.shadow_pixel.push_back(static_cast<std::uint32_t>(i));
     }
     w.shadow_ray_count += w.shadow_rays.size();
@@ -67,6 +64,12 @@ void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCam
 }
 
 }  // namespace
+
+SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit) {
+    Vec3 n = normalize(tri.geometric_normal());
+    if (dot(n, ray.dir) > 0.f) n = -n;
+    return {tri.v0 * (1.f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v, n};
+}
 
 Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
     // Far from the origin, move by a fixed number of ulps (integer offset on the float bits), which
