@@ -1,0 +1,210 @@
+// Structures against Embree, in the same run on the same rays: build time, memory and rays per second
+// of primary and shadow rays for every structure and traversal, per scene.
+//
+// The rays of a scene are those of one frame at the view's size: one primary ray per pixel, ordered
+// by 16 x 16 tiles as the renderer traces them, and one shadow ray toward the light per primary hit
+// (hits found by an exact structure, so every configuration traces the very same shadow rays).
+// Each configuration is built `--builds` times (median reported) and traced after a warm-up pass
+// `--repeats` times (median per ray kind), single-threaded unless `--threads` says otherwise.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/render.hpp"
+#include "cellrt/scene.hpp"
+#include "cellrt/timer.hpp"
+
+namespace {
+
+using namespace cellrt;
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+struct FrameRays {
+    std::vector<Ray> primary, shadow;
+};
+
+FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
+    const PinholeCamera camera(scene.camera, width, height);
+    FrameRays f;
+    for (int ty = 0; ty < height; ty += tile)
+        for (int tx = 0; tx < width; tx += tile)
+            for (int y = ty; y < std::min(ty + tile, height); ++y)
+                for (int x = tx; x < std::min(tx + tile, width); ++x) f.primary.push_back(camera.primary(x, y));
+    const auto exact = make_accelerator(scene.triangles, AccelConfig{"bih"});
+    std::vector<Hit> hits(f.primary.size());
+    exact->intersect(f.primary, hits);
+    for (std::size_t i = 0; i < hits.size(); ++i)
+        if (hits[i].is_hit()) {
+            const SurfacePoint sp = surface_point(scene.triangles[hits[i].prim], f.primary[i], hits[i]);
+            f.shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
+        }
+    return f;
+}
+
+AccelConfig parse_config(const std::string& text, unsigned threads) {
+    AccelConfig c;
+    const auto colon = text.find(':');
+    c.kind = text.substr(0, colon);
+    if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
+    c.threads = threads;
+    return c;
+}
+
+struct Result {
+    std::string config;
+    double build_s = 0, memory_mib = 0, primary_s = 0, shadow_s = 0;
+    std::size_t differing = 0;  // primary hits that differ from the exact answer
+    TraversalCounters primary_work, shadow_work;
+};
+
+double per_ray(std::uint64_t n, const TraversalCounters& c) { return c.rays ? double(n) / double(c.rays) : 0.0; }
+
+// Times one pass over `rays` in batches of `batch` rays (one accelerator call each).
+template <class Call>
+double timed_pass(std::size_t n, std::size_t batch, Call&& call) {
+    Timer t;
+    for (std::size_t i = 0; i < n; i += batch) call(i, std::min(batch, n - i));
+    return t.seconds();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"cellrt structures vs Embree: build time, memory, Mrays/s on the same rays in the same run"};
+    std::string scenes_dir = "../shared/scenes";
+    std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
+    std::vector<std::string> configs{"embree:single", "kd:rec", "kd:branched", "kd:branchless", "bih:branched",
+                                     "bih:branchless"};
+    int repeats = 5, builds = 3, batch = 256;
+    unsigned threads = 1;
+    std::string size, json_path;
+    app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
+    app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
+    app.add_option("--configs", configs, "KIND[:TRAVERSAL]; the first embree one is the yardstick")->capture_default_str();
+    app.add_option("--repeats", repeats, "Timed passes per ray kind (median)")->capture_default_str()->check(CLI::Range(1, 1000));
+    app.add_option("--builds", builds, "Timed builds (median)")->capture_default_str()->check(CLI::Range(1, 100));
+    app.add_option("--batch", batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));
+    app.add_option("--threads", threads, "Build threads (tracing is single-threaded)")->capture_default_str();
+    app.add_option("--size", size, "Image size WxH (default: the view file's)");
+    app.add_option("--json", json_path, "Write every result as JSON");
+    CLI11_PARSE(app, argc, argv);
+
+    nlohmann::json out = nlohmann::json::array();
+    try {
+        for (const std::string& name : scenes) {
+            std::string spec = name;
+            if (name.rfind("builtin:", 0) != 0) {
+                spec = (std::filesystem::path(scenes_dir) / name / (name + ".json")).string();
+                if (!std::filesystem::exists(spec)) {
+                    std::fprintf(stderr, "skipping %s: %s not found\n", name.c_str(), spec.c_str());
+                    continue;
+                }
+            }
+            const Scene scene = load_scene(spec);
+            int w = scene.width, h = scene.height;
+            if (!size.empty() && std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2) throw Error("--size must be WxH");
+            const FrameRays rays = frame_rays(scene, w, h, 16);
+            std::vector<Hit> exact(rays.primary.size());
+            make_accelerator(scene.triangles, AccelConfig{"bih"})->intersect(rays.primary, exact);
+
+            std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
+                        scene.triangles.size(), w, h, rays.primary.size(), rays.shadow.size());
+            std::printf("| config | build ms | build / Embree | memory MiB | primary Mrays/s | shadow Mrays/s | "
+                        "total Mrays/s | × Embree | hits ≠ exact | nodes/leaves/tris per primary ray | per shadow ray "
+                        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+            std::vector<Result> results;
+            results.reserve(configs.size());  // `yardstick` points into it
+            const Result* yardstick = nullptr;
+            for (const std::string& text : configs) {
+                const AccelConfig cfg = parse_config(text, threads);
+                const auto kinds = accelerator_kinds();
+                if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
+                    std::fprintf(stderr, "skipping %s: not built into this binary\n", text.c_str());
+                    continue;
+                }
+                Result r;
+                r.config = text;
+                std::vector<double> build_times;
+                std::unique_ptr<Accelerator> accel;
+                for (int b = 0; b < builds; ++b) {
+                    accel.reset();
+                    accel = make_accelerator(scene.triangles, cfg);
+                    build_times.push_back(accel->stats().build_seconds);
+                }
+                r.build_s = median(build_times);
+                r.memory_mib = static_cast<double>(accel->stats().memory_bytes) / (1024.0 * 1024.0);
+                std::vector<Hit> hits(rays.primary.size());
+                std::vector<std::uint8_t> occluded(rays.shadow.size());
+                const std::size_t bs = static_cast<std::size_t>(batch);
+                auto primary = [&](std::size_t i, std::size_t n) {
+                    accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
+                };
+                auto shadow = [&](std::size_t i, std::size_t n) {
+                    accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
+                };
+                timed_pass(rays.primary.size(), bs, primary);
+                timed_pass(rays.shadow.size(), bs, shadow);
+                std::vector<double> tp, ts;
+                for (int k = 0; k < repeats; ++k) {
+                    tp.push_back(timed_pass(rays.primary.size(), bs, primary));
+                    ts.push_back(timed_pass(rays.shadow.size(), bs, shadow));
+                }
+                r.primary_s = median(tp);
+                r.shadow_s = median(ts);
+                accel->intersect(rays.primary, hits, &r.primary_work);
+                accel->occluded(rays.shadow, occluded, &r.shadow_work);
+                for (std::size_t i = 0; i < hits.size(); ++i) r.differing += !(hits[i].prim == exact[i].prim);
+                results.push_back(r);
+                if (!yardstick && cfg.kind == "embree") yardstick = &results.back();
+
+                const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.shadow.size());
+                const double total = (np + ns) / (r.primary_s + r.shadow_s) * 1e-6;
+                char build_ratio[32] = "–", speed_ratio[32] = "–";
+                if (yardstick) {
+                    const double ytotal = (np + ns) / (yardstick->primary_s + yardstick->shadow_s) * 1e-6;
+                    std::snprintf(build_ratio, sizeof build_ratio, "%.2f", r.build_s / yardstick->build_s);
+                    std::snprintf(speed_ratio, sizeof speed_ratio, "%.2f", total / ytotal);
+                }
+                const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
+                std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %zu | %.1f / %.1f / %.1f | %.1f / %.1f / "
+                            "%.1f |\n",
+                            text.c_str(), r.build_s * 1e3, build_ratio, r.memory_mib, np / r.primary_s * 1e-6,
+                            ns / r.shadow_s * 1e-6, total, speed_ratio, r.differing, per_ray(pw.nodes, pw),
+                            per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
+                            per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
+                std::fflush(stdout);
+                out.push_back({{"scene", scene.name},
+                               {"config", text},
+                               {"triangles", scene.triangles.size()},
+                               {"primary_rays", rays.primary.size()},
+                               {"shadow_rays", rays.shadow.size()},
+                               {"build_seconds", r.build_s},
+                               {"memory_mib", r.memory_mib},
+                               {"primary_seconds", r.primary_s},
+                               {"shadow_seconds", r.shadow_s},
+                               {"differing_primary_hits", r.differing},
+                               {"primary_per_ray", {{"nodes", per_ray(pw.nodes, pw)}, {"leaves", per_ray(pw.leaves, pw)},
+                                                    {"triangles", per_ray(pw.triangles, pw)}}},
+                               {"shadow_per_ray", {{"nodes", per_ray(sw.nodes, sw)}, {"leaves", per_ray(sw.leaves, sw)},
+                                                   {"triangles", per_ray(sw.triangles, sw)}}}});
+            }
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "cellrt_bench: error: %s\n", e.what());
+        return 1;
+    }
+    if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
+    return 0;
+}
