@@ -1,0 +1,73 @@
+#include "cli.hpp"
+
+#include <cstdio>
+#include <unistd.h>
+
+#include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
+
+namespace cellrt::cli {
+
+std::atomic<bool> g_cancel{false};
+
+std::string scene_help() {
+    std::string names;
+    for (const auto& b : builtin_scenes()) names += (names.empty() ? "" : ", ") + b.name;
+    return "Scene: VIEW.json, MESH.obj, MESH.ply, or builtin:NAME[?tris=N&seed=S] (" + names + ")";
+}
+
+void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {
+    std::string kinds;
+    for (const auto& k : accelerator_kinds()) kinds += (kinds.empty() ? "" : "|") + k;
+    if (kind_optional) kind.clear();
+    cmd.add_option("--accel", kind, "Acceleration structure: " + kinds)->capture_default_str();
+    cmd.add_option("--traversal", traversal, "Traversal variant (per structure; docs/KDTREE.md, docs/BIH.md)");
+    cmd.add_option("-P,--param", params, "Build parameter NAME=VALUE (repeatable; docs/KDTREE.md, docs/BIH.md)");
+    cmd.add_option("--threads", threads, "Worker and build threads (0: all cores)")->capture_default_str();
+}
+
+AccelConfig AccelOptions::config() const {
+    AccelConfig c;
+    c.kind = kind;
+    c.traversal = traversal;
+    c.threads = threads;
+    for (const std::string& p : params) {
+        const auto eq = p.find('=');
+        if (eq == std::string::npos || eq == 0) throw Error("--param '" + p + "' must have the form NAME=VALUE");
+        c.params[p.substr(0, eq)] = p.substr(eq + 1);
+    }
+    return c;
+}
+
+void print_stats(const AccelStats& s) {
+    std::printf("structure        %s\n", s.name.c_str());
+    std::printf("build time       %.3f s\n", s.build_seconds);
+    std::printf("memory           %.2f MiB\n", static_cast<double>(s.memory_bytes) / (1024.0 * 1024.0));
+    for (const auto& [k, v] : s.figures) std::printf("%-16s %s\n", k.c_str(), v.c_str());
+}
+
+std::pair<int, int> parse_size(const std::string& option, const std::string& text) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 65536 ||
+        h > 65536)
+        throw Error(option + " '" + text + "' must be WIDTHxHEIGHT with both in [1, 65536]");
+    return {w, h};
+}
+
+Progress::Progress() : enabled_(::isatty(STDERR_FILENO)) {}
+
+Progress::~Progress() {
+    if (shown_) std::fprintf(stderr, "\n");
+}
+
+void Progress::operator()(std::size_t done, std::size_t total) {
+    if (!enabled_ || timer_.seconds() < 1.0) return;
+    std::lock_guard lock(mutex_);
+    const int width = 40, filled = static_cast<int>(width * done / total);
+    std::fprintf(stderr, "\r[%s%s] %3zu%%", std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
+                 100 * done / total);
+    shown_ = true;
+}
+
+}  // namespace cellrt::cli

@@ -1,0 +1,62 @@
+// Pieces shared by the subcommands of the cellrt program. Each subcommand lives in a file of its own
+// (cmd_*.cpp) and registers itself with add_*(): it adds its options to the program and returns the
+// function that runs it once the command line is parsed.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/timer.hpp"
+
+namespace cellrt::cli {
+
+using Runner = std::function<int()>;
+
+Runner add_render(CLI::App& app);
+Runner add_info(CLI::App& app);
+
+// Set by SIGINT/SIGTERM; renders stop at the next packet and leave no partial output.
+extern std::atomic<bool> g_cancel;
+
+// The scene argument's help text (view file, mesh or builtin:NAME).
+std::string scene_help();
+
+// --accel, --traversal, -P NAME=VALUE and --threads, shared by every command that builds a structure.
+struct AccelOptions {
+    std::string kind = "kd";
+    std::string traversal;
+    std::vector<std::string> params;
+    unsigned threads = 0;
+
+    void add_to(CLI::App& cmd, bool kind_optional);
+    AccelConfig config() const;
+};
+
+void print_stats(const AccelStats& s);
+
+// WIDTHxHEIGHT, both in [1, 65536]; throws cellrt::Error naming the option otherwise.
+std::pair<int, int> parse_size(const std::string& option, const std::string& text);
+
+// A one-line progress bar on stderr, shown only on a terminal and only once a render has run for a
+// second.
+class Progress {
+public:
+    Progress();
+    ~Progress();
+    void operator()(std::size_t done, std::size_t total);
+
+private:
+    bool enabled_;
+    bool shown_ = false;
+    Timer timer_;
+    std::mutex mutex_;
+};
+
+}  // namespace cellrt::cli
