@@ -9,6 +9,8 @@
 // recomputed in double precision (section 3 of the paper) so that the sign of a tiny value is right.
 #pragma once
 
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -54,10 +56,13 @@ struct WatertightRay {
 // Returns false when the ray misses the triangle's plane region or the triangle is degenerate
 // (det == 0: zero area, or seen edge-on).
 inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
-    const Vec3 a = tri.v0 - r.org, b = tri.v1 - r.org, c = tri.v2 - r.org;
-    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    // The vertices' coordinates in ray order (x, y, z of v0, v1, v2 as nine floats, read by index).
+    const auto c9 = std::bit_cast<std::array<float, 9>>(tri);
+    const float ox = r.org[r.kx], oy = r.org[r.ky], oz = r.org[r.kz];
+    const float a_kz = c9[r.kz] - oz, b_kz = c9[3 + r.kz] - oz, c_kz = c9[6 + r.kz] - oz;
+    const float ax = (c9[r.kx] - ox) - r.sx * a_kz, ay = (c9[r.ky] - oy) - r.sy * a_kz;
+    const float bx = (c9[3 + r.kx] - ox) - r.sx * b_kz, by = (c9[3 + r.ky] - oy) - r.sy * b_kz;
+    const float cx = (c9[6 + r.kx] - ox) - r.sx * c_kz, cy = (c9[6 + r.ky] - oy) - r.sy * c_kz;
     float eu = cx * by - cy * bx;
     float ev = ax * cy - ay * cx;
     float ew = bx * ay - by * ax;
@@ -69,7 +74,7 @@ inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, flo
     if ((eu < 0.f || ev < 0.f || ew < 0.f) && (eu > 0.f || ev > 0.f || ew > 0.f)) return false;
     const float det = eu + ev + ew;
     if (det == 0.f) return false;
-    const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    const float az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
     const float big_t = eu * az + ev * bz + ew * cz;
     const float inv_det = 1.f / det;
     t = big_t * inv_det;

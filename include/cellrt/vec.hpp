@@ -2,6 +2,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 
@@ -14,7 +16,8 @@ struct Vec3 {
     constexpr Vec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
     constexpr explicit Vec3(float s) : x(s), y(s), z(s) {}
 
-    constexpr float operator[](std::size_t i) const { return i == 0 ? x : (i == 1 ? y : z); }
+    // Indexed read as an array load (no chain of selects): the kernels index by per-ray axes.
+    constexpr float operator[](std::size_t i) const { return std::bit_cast<std::array<float, 3>>(*this)[i]; }
     constexpr float& operator[](std::size_t i) { return i == 0 ? x : (i == 1 ? y : z); }
 
     constexpr Vec3 operator-() const { return {-x, -y, -z}; }

@@ -13,13 +13,31 @@
 
 namespace cellrt::detail {
 
+// The last few triangles a ray tested (a "mailbox", Amanatides & Woo 1987; Havran's thesis section
+// 4.5): a kd-tree references a triangle from every leaf it overlaps, and a ray crossing neighbouring
+// leaves would test it again with the same answer.
+struct Mailbox {
+    static constexpr int kSize = 8;
+    std::uint32_t slot[kSize] = {~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u};
+    unsigned next = 0;
+
+    // True when `prim` was tested recently; otherwise remembers it.
+    bool seen(std::uint32_t prim) {
+        bool found = false;
+        for (int i = 0; i < kSize; ++i) found |= slot[i] == prim;
+        if (!found) slot[next++ % kSize] = prim;
+        return found;
+    }
+};
+
 // Tests the triangles of a leaf; true when an any-hit query is answered.
 template <class Query, class Memory, class Counters>
-bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c, Mailbox& tested) {
     c.leaf();
     const std::uint32_t end = leaf.first() + leaf.count();
     for (std::uint32_t k = leaf.first(); k < end; ++k) {
         const std::uint32_t prim = mem.index(k);
+        if (tested.seen(prim)) continue;
         c.triangle();
         if (q.test(r.watertight, mem.triangle(prim), prim)) return true;
     }
@@ -36,6 +54,7 @@ bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r
     };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    Mailbox tested;
     Entry stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t index = 0;
@@ -59,7 +78,7 @@ bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r
             }
             n = mem.node(index);
         }
-        if (kd_leaf(n, mem, r, q, c)) return true;
+        if (kd_leaf(n, mem, r, q, c, tested)) return true;
         do {
             if (sp == 0) return false;
             --sp;
@@ -81,6 +100,7 @@ bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay&
     };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    Mailbox tested;
     Entry stack[kKdMaxDepth + 2];
     int sp = 0;
     std::uint32_t index = 0;
@@ -103,7 +123,7 @@ bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay&
             tmax = stack[sp].tmax;
             n = mem.node(index);
         }
-        if (kd_leaf(n, mem, r, q, c)) return true;
+        if (kd_leaf(n, mem, r, q, c, tested)) return true;
         do {
             if (sp == 0) return false;
             --sp;
@@ -132,6 +152,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
     };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
+    Mailbox tested;
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
     const float reach = r.margin * length(r.dir);
     const Vec3 o = abs(r.org);
@@ -176,7 +197,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
             }
             n = mem.node(index);
         }
-        if (kd_leaf(n, mem, r, q, c)) return true;
+        if (kd_leaf(n, mem, r, q, c, tested)) return true;
         // Continue with the node that starts at the leaf's exit point, unless it starts past the answer.
         for (;;) {
             if (stack[ex].far == kNone) return false;
