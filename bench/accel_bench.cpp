@@ -53,8 +53,13 @@ FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
     return f;
 }
 
-AccelConfig parse_config(const std::string& text, unsigned threads) {
+// KIND[:TRAVERSAL][+SIMD], e.g. kd:branched, bih+avx2 (SIMD packets), embree:packet16.
+AccelConfig parse_config(std::string text, unsigned threads) {
     AccelConfig c;
+    if (const auto plus = text.find('+'); plus != std::string::npos) {
+        c.simd = text.substr(plus + 1);
+        text = text.substr(0, plus);
+    }
     const auto colon = text.find(':');
     c.kind = text.substr(0, colon);
     if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
@@ -92,7 +97,7 @@ int main(int argc, char** argv) {
     std::string size, json_path;
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
-    app.add_option("--configs", configs, "KIND[:TRAVERSAL]; the first embree one is the yardstick")->capture_default_str();
+    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")->capture_default_str();
     app.add_option("--repeats", repeats, "Timed passes per ray kind (median)")->capture_default_str()->check(CLI::Range(1, 1000));
     app.add_option("--builds", builds, "Timed builds (median)")->capture_default_str()->check(CLI::Range(1, 100));
     app.add_option("--batch", batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));

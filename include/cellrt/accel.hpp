@@ -33,6 +33,10 @@ struct TraversalCounters {
 struct AccelConfig {
     std::string kind = "kd";   // see accelerator_kinds()
     std::string traversal;     // empty: the structure's default
+    // SIMD packet kernels: "off" (one ray at a time, with `traversal`), "auto" (the best instruction
+    // set this binary and processor have), "portable", "sse", "avx2" or "avx512". With packets, each
+    // batch is traced kLanes rays at a time (4, 8 or 16), large batches after an entry-point search.
+    std::string simd = "off";
     unsigned threads = 0;      // build threads; 0: all hardware threads
     std::map<std::string, std::string> params;  // structure-specific build parameters, name -> value
 };

@@ -1,15 +1,18 @@
 #include "cellrt/brute_force.hpp"
 
 #include "cellrt/timer.hpp"
+#include "packet/packet.hpp"
 
 namespace cellrt {
 namespace {
 
 class BruteForce final : public Accelerator {
 public:
-    explicit BruteForce(std::span<const Triangle> triangles) : triangles_(triangles) {}
+    BruteForce(std::span<const Triangle> triangles, const detail::PacketKernels* packets)
+        : triangles_(triangles), packets_(packets) {}
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        if (packets_) return packets_->brute_closest(triangles_, rays, hits, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
             Hit best = miss_for(ray);
@@ -25,6 +28,7 @@ public:
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
+        if (packets_) return packets_->brute_any(triangles_, rays, occluded, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
             occluded[i] = 0;
@@ -51,6 +55,7 @@ private:
         counters->triangles += n * triangles_.size();
     }
     std::span<const Triangle> triangles_;
+    const detail::PacketKernels* packets_;
 };
 
 }  // namespace
@@ -59,7 +64,7 @@ std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangle
     ParamReader params(config, "brute");
     traversal_or_default(config, {"loop"}, "brute");
     params.finish();
-    return std::make_unique<BruteForce>(triangles);
+    return std::make_unique<BruteForce>(triangles, detail::packet_kernels_for(config));
 }
 
 }  // namespace cellrt

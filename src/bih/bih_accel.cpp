@@ -1,6 +1,7 @@
 #include "bih_accel.hpp"
 
 #include "bih_traversal.hpp"
+#include "packet/packet.hpp"
 #include "cellrt/timer.hpp"
 
 namespace cellrt::detail {
@@ -19,14 +20,16 @@ BihBuildParams read_params(const AccelConfig& config) {
 
 class BihAccelerator final : public Accelerator {
 public:
-    BihAccelerator(std::span<const Triangle> triangles, const BihBuildParams& params, BihTraversal traversal)
-        : params_(params), traversal_(traversal) {
+    BihAccelerator(std::span<const Triangle> triangles, const BihBuildParams& params, BihTraversal traversal,
+                   const PacketKernels* packets)
+        : params_(params), traversal_(traversal), packets_(packets) {
         Timer timer;
         tree_ = build_bih(triangles, params);
         build_seconds_ = timer.seconds();
     }
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        if (packets_) return packets_->bih_closest(tree_, rays, hits, counters);
         DirectMemory<BihNode> mem = memory();
         with_bih_kernel(traversal_, [&](auto kernel) {
             closest_hits(tree_.bounds, rays, hits, counters,
@@ -36,6 +39,7 @@ public:
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
+        if (packets_) return packets_->bih_any(tree_, rays, occluded, counters);
         DirectMemory<BihNode> mem = memory();
         with_bih_kernel(traversal_, [&](auto kernel) {
             any_hits(tree_.bounds, rays, occluded, counters,
@@ -47,7 +51,8 @@ public:
         AccelStats s{"bih", build_seconds_,
                      tree_.nodes.size() * sizeof(BihNode) + tree_.triangles.size() * sizeof(Triangle) +
                          tree_.prims.size() * sizeof(std::uint32_t),
-                     {{"traversal", traversal_ == BihTraversal::branched ? "branched" : "branchless"}}};
+                     {{"traversal", packets_ ? "packet" : traversal_ == BihTraversal::branched ? "branched" : "branchless"},
+                      {"simd lanes", packets_ ? std::to_string(packets_->lanes) : "off"}}};
         for (auto& f : bih_report(tree_, params_)) s.figures.push_back(std::move(f));
         return s;
     }
@@ -57,6 +62,7 @@ private:
 
     BihBuildParams params_;
     BihTraversal traversal_;
+    const PacketKernels* packets_;
     BihTree tree_;
     double build_seconds_ = 0.0;
 };
@@ -67,7 +73,8 @@ std::unique_ptr<Accelerator> make_bih(std::span<const Triangle> triangles, const
     const BihBuildParams params = read_params(config);
     const std::string t = traversal_or_default(config, {"branchless", "branched"}, "bih");
     return std::make_unique<BihAccelerator>(triangles, params,
-                                            t == "branched" ? BihTraversal::branched : BihTraversal::branchless);
+                                            t == "branched" ? BihTraversal::branched : BihTraversal::branchless,
+                                            packet_kernels_for(config));
 }
 
 }  // namespace cellrt::detail

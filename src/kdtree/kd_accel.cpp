@@ -2,6 +2,7 @@
 
 #include "cellrt/timer.hpp"
 #include "kd_traversal.hpp"
+#include "packet/packet.hpp"
 
 namespace cellrt::detail {
 namespace {
@@ -37,14 +38,16 @@ const char* name(KdTraversal t) {
 
 class KdAccelerator final : public Accelerator {
 public:
-    KdAccelerator(std::span<const Triangle> triangles, const KdBuildParams& params, KdTraversal traversal)
-        : triangles_(triangles), params_(params), traversal_(traversal) {
+    KdAccelerator(std::span<const Triangle> triangles, const KdBuildParams& params, KdTraversal traversal,
+                  const PacketKernels* packets)
+        : triangles_(triangles), params_(params), traversal_(traversal), packets_(packets) {
         Timer timer;
         tree_ = build_kdtree(triangles, params);
         build_seconds_ = timer.seconds();
     }
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        if (packets_) return packets_->kd_closest(tree_, triangles_.data(), rays, hits, counters);
         DirectMemory<KdNode> mem = memory();
         with_kd_kernel(traversal_, [&](auto kernel) {
             closest_hits(tree_.bounds, rays, hits, counters,
@@ -54,6 +57,7 @@ public:
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
+        if (packets_) return packets_->kd_any(tree_, triangles_.data(), rays, occluded, counters);
         DirectMemory<KdNode> mem = memory();
         with_kd_kernel(traversal_, [&](auto kernel) {
             any_hits(tree_.bounds, rays, occluded, counters,
@@ -64,7 +68,8 @@ public:
     AccelStats stats() const override {
         AccelStats s{"kd", build_seconds_,
                      tree_.nodes.size() * sizeof(KdNode) + tree_.indices.size() * sizeof(std::uint32_t),
-                     {{"traversal", name(traversal_)}}};
+                     {{"traversal", packets_ ? "packet" : name(traversal_)},
+                      {"simd lanes", packets_ ? std::to_string(packets_->lanes) : "off"}}};
         for (auto& f : kd_report(tree_, params_)) s.figures.push_back(std::move(f));
         return s;
     }
@@ -75,6 +80,7 @@ private:
     std::span<const Triangle> triangles_;
     KdBuildParams params_;
     KdTraversal traversal_;
+    const PacketKernels* packets_;
     KdTree tree_;
     double build_seconds_ = 0.0;
 };
@@ -84,7 +90,7 @@ private:
 std::unique_ptr<Accelerator> make_kdtree(std::span<const Triangle> triangles, const AccelConfig& config) {
     const KdBuildParams params = read_params(config);
     const KdTraversal traversal = read_traversal(config);
-    return std::make_unique<KdAccelerator>(triangles, params, traversal);
+    return std::make_unique<KdAccelerator>(triangles, params, traversal, packet_kernels_for(config));
 }
 
 }  // namespace cellrt::detail

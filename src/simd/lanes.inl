@@ -1,0 +1,41 @@
+// SIMD lanes for the packet kernels: GCC/Clang generic vectors of kLanes floats, included inside an
+// instruction-set namespace (see isa.hpp) that defines kLanes. Arithmetic on these types is IEEE
+// single precision lane by lane with no contraction (-ffp-contract=off), so a lane computes the very
+// bits the scalar code computes from the same operands in the same order.
+//
+// No include guard: every instruction set includes it once, in its own namespace and target.
+
+typedef float F __attribute__((vector_size(4 * kLanes)));
+typedef std::int32_t I __attribute__((vector_size(4 * kLanes)));  // lane masks: -1 true, 0 false
+typedef std::uint32_t U __attribute__((vector_size(4 * kLanes)));
+
+inline F splat(float x) { return F{} + x; }
+inline I splat_i(std::int32_t x) { return I{} + x; }
+inline U splat_u(std::uint32_t x) { return U{} + x; }
+inline I mask_of(bool b) { return splat_i(b ? -1 : 0); }
+
+// Bit i set when lane i of the mask is true: one instruction where the set has one (the including
+// file defines CELLRT_SIMD_SSE, _AVX2 or _AVX512 when it compiles for that set).
+inline unsigned bits(I m) {
+#if defined(CELLRT_SIMD_AVX512)
+    return _mm512_movepi32_mask(reinterpret_cast<__m512i>(m));
+#elif defined(CELLRT_SIMD_AVX2)
+    return static_cast<unsigned>(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+#elif defined(CELLRT_SIMD_SSE)
+    return static_cast<unsigned>(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+#else
+    unsigned out = 0;
+    for (int i = 0; i < kLanes; ++i) out |= (m[i] < 0 ? 1u : 0u) << i;
+    return out;
+#endif
+}
+inline bool any(I m) { return bits(m) != 0; }
+
+// Lane-wise a ? b : c, for floats and integers.
+inline F select(I m, F a, F b) { return m ? a : b; }
+inline I select(I m, I a, I b) { return m ? a : b; }
+inline U select(I m, U a, U b) { return m ? a : b; }
+
+// The scalar kernels' NaN-keeping min/max (accel/traversal.hpp), lane by lane.
+inline F min_keep(F kept, F x) { return select(x < kept, x, kept); }
+inline F max_keep(F kept, F x) { return select(x > kept, x, kept); }
