@@ -9,6 +9,9 @@
 #include "cellrt/error.hpp"
 #include "bih/bih_accel.hpp"
 #include "kdtree/kd_accel.hpp"
+#ifdef CELLRT_HAVE_EMBREE
+#include "../embree/embree_accel.hpp"
+#endif
 
 namespace cellrt {
 
@@ -26,6 +29,9 @@ constexpr Entry kAccelerators[] = {
     {"brute", &make_brute_force},
     {"kd", &detail::make_kdtree},
     {"bih", &detail::make_bih},
+#ifdef CELLRT_HAVE_EMBREE
+    {"embree", &make_embree},
+#endif
 };
 
 std::string join(const std::vector<std::string>& items) {
