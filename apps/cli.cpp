@@ -21,7 +21,11 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {
     for (const auto& k : accelerator_kinds()) kinds += (kinds.empty() ? "" : "|") + k;
     if (kind_optional) kind.clear();
     cmd.add_option("--accel", kind, "Acceleration structure: " + kinds)->capture_default_str();
-    cmd.add_option("--traversal", traversal, "Traversal variant (per structure; docs/KDTREE.md, docs/BIH.md)");
+    cmd.add_option("--traversal", traversal,
+                   "Single-ray traversal (kd: rec|branched|branchless, bih: branched|branchless); implies --simd off");
+    simd_option = cmd.add_option("--simd", simd,
+                                 "SIMD ray packets: auto|off|portable|sse|avx2|avx512 (docs/PACKETS.md)")
+                      ->capture_default_str();
     cmd.add_option("-P,--param", params, "Build parameter NAME=VALUE (repeatable; docs/KDTREE.md, docs/BIH.md)");
     cmd.add_option("--threads", threads, "Worker and build threads (0: all cores)")->capture_default_str();
 }
@@ -30,6 +34,7 @@ AccelConfig AccelOptions::config() const {
     AccelConfig c;
     c.kind = kind;
     c.traversal = traversal;
+    c.simd = !traversal.empty() && simd_option && simd_option->count() == 0 ? "off" : simd;
     c.threads = threads;
     for (const std::string& p : params) {
         const auto eq = p.find('=');

@@ -21,6 +21,8 @@ using Runner = std::function<int()>;
 
 Runner add_render(CLI::App& app);
 Runner add_info(CLI::App& app);
+Runner add_profile(CLI::App& app);
+Runner add_cache_study(CLI::App& app);
 
 // Set by SIGINT/SIGTERM; renders stop at the next packet and leave no partial output.
 extern std::atomic<bool> g_cancel;
@@ -28,12 +30,16 @@ extern std::atomic<bool> g_cancel;
 // The scene argument's help text (view file, mesh or builtin:NAME).
 std::string scene_help();
 
-// --accel, --traversal, -P NAME=VALUE and --threads, shared by every command that builds a structure.
+// --accel, --traversal, --simd, -P NAME=VALUE and --threads, shared by every command that builds a
+// structure. SIMD packets are the default; naming a --traversal (a single-ray kernel) without --simd
+// turns them off.
 struct AccelOptions {
     std::string kind = "kd";
     std::string traversal;
+    std::string simd = "auto";
     std::vector<std::string> params;
     unsigned threads = 0;
+    CLI::Option* simd_option = nullptr;
 
     void add_to(CLI::App& cmd, bool kind_optional);
     AccelConfig config() const;
@@ -43,6 +49,9 @@ void print_stats(const AccelStats& s);
 
 // WIDTHxHEIGHT, both in [1, 65536]; throws cellrt::Error naming the option otherwise.
 std::pair<int, int> parse_size(const std::string& option, const std::string& text);
+
+// Writes `text` beside `path` and renames it into place; replaces an existing file only with `overwrite`.
+void write_text_file(const std::string& path, const std::string& text, bool overwrite);
 
 // A one-line progress bar on stderr, shown only on a terminal and only once a render has run for a
 // second.

@@ -176,8 +176,12 @@ struct ReferenceAnswers {
     std::vector<std::uint8_t> occluded;
 };
 
+// Brute force over all of `rays`, with the SIMD kernels of the best instruction set (held to the
+// scalar loop by BruteForcePackets.SameAnswersAsTheScalarLoop).
 inline ReferenceAnswers compute_reference(std::span<const Triangle> tris, std::vector<Ray> rays) {
-    const auto brute = make_brute_force(tris, AccelConfig{"brute"});
+    AccelConfig config{"brute"};
+    config.simd = "auto";
+    const auto brute = make_brute_force(tris, config);
     ReferenceAnswers ref;
     ref.rays = std::move(rays);
     ref.hits.resize(ref.rays.size());

@@ -4,23 +4,41 @@
 #include <gtest/gtest.h>
 
 #include "cellrt/accel.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/render.hpp"
 #include "ray_suite.hpp"
+#include "simd/isa.hpp"
 #include "structure_cases.hpp"
 
 namespace cellrt {
 namespace {
 
-// KIND:TRAVERSAL of every exact structure path.
-const std::vector<std::string> kConfigs = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless"};
+// Every exact structure path: KIND:TRAVERSAL for single rays, KIND+SIMD for the packet kernels of
+// each instruction set this machine runs.
+std::vector<std::string> exact_configs() {
+    std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless"};
+    for (detail::Isa isa : detail::available_isas())
+        for (const char* kind : {"kd", "bih"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
+    return out;
+}
+const std::vector<std::string> kConfigs = exact_configs();
 
-AccelConfig parse(const std::string& text) {
+AccelConfig parse(std::string text) {
+    AccelConfig c;
+    if (const auto plus = text.find('+'); plus != std::string::npos) {
+        c.simd = text.substr(plus + 1);
+        text = text.substr(0, plus);
+    }
     const auto colon = text.find(':');
-    return AccelConfig{text.substr(0, colon), text.substr(colon + 1)};
+    c.kind = text.substr(0, colon);
+    if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
+    return c;
 }
 
 std::string name_of(const std::string& config) {
     std::string s = config;
     std::replace(s.begin(), s.end(), ':', '_');
+    std::replace(s.begin(), s.end(), '+', '_');
     return s;
 }
 
@@ -52,6 +70,80 @@ TEST_P(DegenerateInputs, SameHits) {
 
 INSTANTIATE_TEST_SUITE_P(Structures, DegenerateInputs, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
+
+// The packet kernels on the rays they are made for: a frame's primary rays in square tiles and the
+// shadow rays of their hits, in batches of 8 x 8 and 16 x 16 (entry-point search) and of sizes that
+// leave the last packet partly empty.
+class CoherentPackets : public testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+TEST_P(CoherentPackets, SameHits) {
+    const auto& [scene_name, config] = GetParam();
+    const Scene* scene = test::structure_scene(scene_name);
+    if (!scene) GTEST_SKIP() << "scene " << scene_name << " not found under " << test::scenes_dir();
+    const int size = 64;
+    std::vector<Ray> rays;
+    const PinholeCamera camera(scene->camera, size, size);
+    for (int tile : {8, 16})
+        for (int ty = 0; ty < size; ty += tile)
+            for (int tx = 0; tx < size; tx += tile)
+                for (int y = ty; y < ty + tile; ++y)
+                    for (int x = tx; x < tx + tile; ++x) rays.push_back(camera.primary(x, y));
+    test::ReferenceAnswers ref = test::compute_reference(scene->triangles, rays);
+    for (std::size_t i = 0; i < ref.rays.size(); ++i)
+        if (ref.hits[i].is_hit()) {
+            const SurfacePoint sp = surface_point(scene->triangles[ref.hits[i].prim], ref.rays[i], ref.hits[i]);
+            rays.push_back(shadow_ray(sp.position, sp.normal, scene->light.position));
+        }
+    ref = test::compute_reference(scene->triangles, rays);
+    const auto accel = make_accelerator(scene->triangles, parse(config));
+    for (std::size_t batch : {64u, 256u, 37u}) {
+        std::vector<Hit> hits(rays.size());
+        std::vector<std::uint8_t> occluded(rays.size());
+        for (std::size_t i = 0; i < rays.size(); i += batch) {
+            const std::size_t n = std::min(batch, rays.size() - i);
+            accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n));
+            accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
+        }
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
+        EXPECT_EQ(bad, 0u) << config << " on " << scene_name << ", batches of " << batch;
+    }
+}
+
+std::vector<std::string> packet_configs() {
+    std::vector<std::string> out;
+    for (const std::string& c : kConfigs)
+        if (c.find('+') != std::string::npos) out.push_back(c);
+    return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, CoherentPackets,
+                         testing::Combine(testing::ValuesIn(test::structure_scene_names()),
+                                          testing::ValuesIn(packet_configs())),
+                         [](const auto& info) {
+                             return test::test_name(std::get<0>(info.param)) + "_" + name_of(std::get<1>(info.param));
+                         });
+
+// The SIMD brute force computes every reference answer of these tests (it is fast); here it is held
+// to the scalar loop, the definition, on whole ray suites.
+TEST(BruteForcePackets, SameAnswersAsTheScalarLoop) {
+    std::vector<std::pair<std::string, std::vector<Triangle>>> scenes = test::degenerate_scenes();
+    scenes.push_back({"spheres", test::cached_scene("builtin:spheres?tris=2000").triangles});
+    for (const auto& [name, tris] : scenes) {
+        test::ReferenceAnswers ref;
+        ref.rays = test::RaySuite(tris, test::small_suite()).rays();
+        ref.hits.resize(ref.rays.size());
+        ref.occluded.resize(ref.rays.size());
+        const auto scalar = make_accelerator(tris, AccelConfig{"brute"});
+        scalar->intersect(ref.rays, ref.hits);
+        scalar->occluded(ref.rays, ref.occluded);
+        for (detail::Isa isa : detail::available_isas()) {
+            AccelConfig c{"brute"};
+            c.simd = detail::to_string(isa);
+            test::expect_matches(*make_accelerator(tris, c), ref, "brute+" + c.simd + " on " + name);
+        }
+    }
+}
 
 }  // namespace
 }  // namespace cellrt

@@ -15,6 +15,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "cellrt/image.hpp"
 
@@ -43,6 +44,11 @@ struct PacketGrid {
     std::size_t count() const { return static_cast<std::size_t>(columns()) * rows(); }
     PixelRect rect(std::size_t index) const;
 };
+
+// The pixels of a packet in the order its rays are traced: Morton (Z) order, so that any 4, 8 or 16
+// consecutive rays (one SIMD packet) cover a compact 2 x 2, 4 x 2 or 4 x 4 block. `order` receives
+// offsets y * rect.width() + x within the rect.
+void packet_order(const PixelRect& rect, std::vector<std::uint32_t>& order);
 
 struct ScheduleOptions {
     Dispatch dispatch = Dispatch::pull;

@@ -25,6 +25,7 @@ struct PacketWork {
     std::vector<std::uint8_t> occluded;
     std::vector<Vec3> normals;
     std::vector<std::uint32_t> shadow_pixel;
+    std::vector<std::uint32_t> order;  // order[i]: the pixel (offset in the packet) of ray i
     TraversalCounters primary, shadow;
     std::uint64_t shadow_ray_count = 0;
 };
@@ -32,9 +33,10 @@ struct PacketWork {
 // Primary rays of the packet, one batch; then one shadow ray per hit, one batch; then shading.
 void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCamera& camera, const PixelRect& rect,
                   bool count, PacketWork& w, std::span<Vec3> colours) {
+    packet_order(rect, w.order);
     w.rays.clear();
-    for (int y = rect.y0; y < rect.y1; ++y)
-        for (int x = rect.x0; x < rect.x1; ++x) w.rays.push_back(camera.primary(x, y));
+    for (const std::uint32_t p : w.order)
+        w.rays.push_back(camera.primary(rect.x0 + static_cast<int>(p) % rect.width(), rect.y0 + static_cast<int>(p) / rect.width()));
     w.hits.resize(w.rays.size());
     accel.intersect(w.rays, w.hits, count ? &w.primary : nullptr);
 
@@ -44,7 +46,7 @@ void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCam
     for (std::size_t i = 0; i < w.rays.size(); ++i) {
         const Hit& h = w.hits[i];
         if (!h.is_hit()) {
-            colours[i] = sky(w.rays[i].dir);
+            colours[w.order[i]] = sky(w.rays[i].dir);
             continue;
         }
         const SurfacePoint sp = surface_point(scene.triangles[h.prim], w.rays[i], h);
@@ -59,7 +61,7 @@ void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCam
     for (std::size_t k = 0; k < w.shadow_rays.size(); ++k) {
         const std::uint32_t i = w.shadow_pixel[k];
         const float lambert = w.occluded[k] ? 0.f : std::max(0.f, dot(w.normals[i], w.shadow_rays[k].dir));
-        colours[i] = kAlbedo * (kAmbient + lambert) * scene.light.color;
+        colours[w.order[i]] = kAlbedo * (kAmbient + lambert) * scene.light.color;
     }
 }
 

@@ -1,5 +1,6 @@
 #include "cellrt/schedule.hpp"
 
+#include <algorithm>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -167,6 +168,23 @@ PixelRect PacketGrid::rect(std::size_t index) const {
     const int cy = static_cast<int>(index / static_cast<std::size_t>(columns()));
     const int x0 = cx * packet, y0 = cy * packet;
     return {x0, y0, std::min(x0 + packet, width), std::min(y0 + packet, height)};
+}
+
+void packet_order(const PixelRect& rect, std::vector<std::uint32_t>& order) {
+    // Interleaves the bits of x and y (x in the even bits): the Morton code of a pixel.
+    auto spread = [](std::uint32_t v) {
+        v &= 0xffff;
+        v = (v | (v << 8)) & 0x00ff00ff;
+        v = (v | (v << 4)) & 0x0f0f0f0f;
+        v = (v | (v << 2)) & 0x33333333;
+        return (v | (v << 1)) & 0x55555555;
+    };
+    order.resize(static_cast<std::size_t>(rect.pixels()));
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    const auto w = static_cast<std::uint32_t>(rect.width());
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return (spread(a % w) | spread(a / w) << 1) < (spread(b % w) | spread(b / w) << 1);
+    });
 }
 
 unsigned worker_count(const ScheduleOptions& options) {
