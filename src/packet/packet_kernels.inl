@@ -27,30 +27,60 @@ struct Lanes {
     int count = 0;  // rays loaded (the rest of the lanes are invalid)
 };
 
+inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }
+inline F max_lanes(F a, F b) { return select(a < b, b, a); }  // std::max's choice, lane by lane
+inline F pick(I is0, I is1, F x, F y, F z) { return select(is0, x, select(is1, y, z)); }
+
+// Loads n <= kLanes rays and computes, lane by lane, every per-ray constant of the single-ray kernels
+// (TraversalRay and WatertightRay) with the same operations, so lanes carry the same bits.
 inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
     Lanes L;
     L.count = n;
-    for (int a = 0; a < 3; ++a) L.org[a] = L.inv[a] = splat(0.f), L.neg[a] = splat_i(0);
-    L.tnear = L.tfar = L.margin = L.sx = L.sy = L.sz = splat(0.f);
-    L.perm = L.valid = splat_i(0);
+    F o[3], d[3], tnear = splat(0.f), tfar = splat(0.f);
+    for (int a = 0; a < 3; ++a) o[a] = d[a] = splat(0.f);
+    I loaded = splat_i(0);
     for (int i = 0; i < n; ++i) {
-        if (!is_valid(rays[i])) continue;
-        // The scalar constructors compute every per-ray constant, so lanes carry the same bits.
-        const TraversalRay r(rays[i], scene_box);
-        for (int a = 0; a < 3; ++a) {
-            L.org[a][i] = r.org[a];
-            L.inv[a][i] = r.inv_dir[a];
-            L.neg[a][i] = r.dir_neg[a] ? -1 : 0;
-        }
-        L.tnear[i] = r.tnear;
-        L.tfar[i] = r.tfar;
-        L.margin[i] = r.margin;
-        L.sx[i] = r.watertight.sx;
-        L.sy[i] = r.watertight.sy;
-        L.sz[i] = r.watertight.sz;
-        L.perm[i] = 2 * r.watertight.kz + (r.watertight.kx == (r.watertight.kz + 1) % 3 ? 0 : 1);
-        L.valid[i] = -1;
+        for (int a = 0; a < 3; ++a) o[a][i] = rays[i].org[a], d[a][i] = rays[i].dir[a];
+        tnear[i] = rays[i].tnear;
+        tfar[i] = rays[i].tfar;
+        loaded[i] = -1;
     }
+    // is_valid (ray.hpp): finite origin and direction (x - x is 0 only for finite x), a direction
+    // that is not zero, tnear <= tfar, no NaN bound.
+    I finite = loaded;
+    for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
+    L.valid = finite & ~((d[0] == 0.f) & (d[1] == 0.f) & (d[2] == 0.f)) & ~(tnear > tfar) & (tnear == tnear) &
+              (tfar == tfar);
+    // Invalid lanes get a harmless ray, so that nothing below divides by zero or meets a NaN.
+    for (int a = 0; a < 3; ++a) {
+        o[a] = select(L.valid, o[a], splat(0.f));
+        d[a] = select(L.valid, d[a], splat(1.f));
+    }
+    for (int a = 0; a < 3; ++a) {
+        L.org[a] = o[a];
+        L.inv[a] = splat(1.f) / d[a];
+        L.neg[a] = (I)d[a] < 0;  // the sign bit, -0 included
+    }
+    L.tnear = tnear;
+    L.tfar = tfar;
+    F reach[3];
+    for (int a = 0; a < 3; ++a)
+        reach[a] = max_lanes(abs_lanes(splat(scene_box.lo[a]) - o[a]), abs_lanes(splat(scene_box.hi[a]) - o[a]));
+    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
+    const F dir_length = sqrt_lanes(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    L.margin = splat(kMarginScale) * reach_length / dir_length;
+    // WatertightRay: kz the largest |d| (ties to the lower axis), kx and ky the next ones, swapped
+    // when d[kz] is negative.
+    const F m0 = abs_lanes(d[0]), m1 = abs_lanes(d[1]), m2 = abs_lanes(d[2]);
+    const I z0 = (m0 >= m1) & (m0 >= m2), z1 = ~(m0 >= m1) & (m1 >= m2);
+    const F dz = pick(z0, z1, d[0], d[1], d[2]);
+    const I swap = dz < 0.f;
+    // kx = kz + 1 and ky = kz + 2 (mod 3), or the other way round when swapped.
+    const F d_next = pick(z0, z1, d[1], d[2], d[0]), d_after = pick(z0, z1, d[2], d[0], d[1]);
+    L.sx = select(swap, d_after, d_next) / dz;
+    L.sy = select(swap, d_next, d_after) / dz;
+    L.sz = splat(1.f) / dz;
+    L.perm = select(z0, splat_i(0), select(z1, splat_i(2), splat_i(4))) + (swap & splat_i(1));
     return L;
 }
 

@@ -31,6 +31,20 @@ inline unsigned bits(I m) {
 }
 inline bool any(I m) { return bits(m) != 0; }
 
+// IEEE square root lane by lane (correctly rounded, so equal to std::sqrt).
+inline F sqrt_lanes(F x) {
+#if defined(CELLRT_SIMD_AVX512)
+    return reinterpret_cast<F>(_mm512_sqrt_ps(reinterpret_cast<__m512>(x)));
+#elif defined(CELLRT_SIMD_AVX2)
+    return reinterpret_cast<F>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+#elif defined(CELLRT_SIMD_SSE)
+    return reinterpret_cast<F>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
+#else
+    for (int i = 0; i < kLanes; ++i) x[i] = std::sqrt(x[i]);
+    return x;
+#endif
+}
+
 // Lane-wise a ? b : c, for floats and integers.
 inline F select(I m, F a, F b) { return m ? a : b; }
 inline I select(I m, I a, I b) { return m ? a : b; }
