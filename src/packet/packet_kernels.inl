@@ -23,6 +23,11 @@ struct Lanes {
     F tnear, tfar, margin;
     F sx, sy, sz;   // the watertight test's shear (WatertightRay)
     I perm;         // its axis permutation: 2 * kz + (kx and ky swapped)
+    // The same permutation as lane masks, for packets whose lanes differ: role r (0: kx, 1: ky,
+    // 2: kz) is the x axis where is_x[r], the y axis where is_y[r], z elsewhere; role_org[r] is the
+    // origin's coordinate on that axis.
+    I is_x[3], is_y[3];
+    F role_org[3];
     I valid;        // lanes holding a valid ray
     int count = 0;  // rays loaded (the rest of the lanes are invalid)
 };
@@ -81,6 +86,13 @@ inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
     L.sy = select(swap, d_next, d_after) / dz;
     L.sz = splat(1.f) / dz;
     L.perm = select(z0, splat_i(0), select(z1, splat_i(2), splat_i(4))) + (swap & splat_i(1));
+    const I z2 = ~z0 & ~z1;
+    // The axis after kz is y when kz = x, z when kz = y, x when kz = z; the one after that follows.
+    const I next_x = z2, next_y = z0, after_x = z1, after_y = z2;
+    L.is_x[0] = select(swap, after_x, next_x), L.is_y[0] = select(swap, after_y, next_y);
+    L.is_x[1] = select(swap, next_x, after_x), L.is_y[1] = select(swap, next_y, after_y);
+    L.is_x[2] = z0, L.is_y[2] = z1;
+    for (int r = 0; r < 3; ++r) L.role_org[r] = pick(L.is_x[r], L.is_y[r], o[0], o[1], o[2]);
     return L;
 }
 
@@ -98,17 +110,27 @@ inline I clip_lanes(const Lanes& L, const Box3& box, F& tmin, F& tmax) {
     return L.valid & (tmin <= tmax);
 }
 
-// The watertight test (triangle.hpp) of one triangle against the lanes of `mask`, which share the
-// axis permutation `perm`. Returns the lanes whose ray meets the triangle, with t, u, v.
+// The watertight test (triangle.hpp) of one triangle against the lanes of `mask`. When they share one
+// axis permutation (`perm` >= 0; the common case for coherent rays) the vertex coordinates are
+// broadcast; otherwise (`perm` < 0) each lane picks its own with masks, so a packet whose lanes point
+// different ways still needs one pass. Returns the lanes whose ray meets the triangle, with t, u, v.
 inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask, F& t, F& u, F& v) {
-    const int kz = perm / 2;
-    int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-    if (perm & 1) std::swap(kx, ky);
-    const F ox = L.org[kx], oy = L.org[ky], oz = L.org[kz];
-    const F a_kz = splat(tri.v0[kz]) - oz, b_kz = splat(tri.v1[kz]) - oz, c_kz = splat(tri.v2[kz]) - oz;
-    const F ax = (splat(tri.v0[kx]) - ox) - L.sx * a_kz, ay = (splat(tri.v0[ky]) - oy) - L.sy * a_kz;
-    const F bx = (splat(tri.v1[kx]) - ox) - L.sx * b_kz, by = (splat(tri.v1[ky]) - oy) - L.sy * b_kz;
-    const F cx = (splat(tri.v2[kx]) - ox) - L.sx * c_kz, cy = (splat(tri.v2[ky]) - oy) - L.sy * c_kz;
+    int axis[3] = {0, 0, 0};
+    if (perm >= 0) {
+        axis[2] = perm / 2;
+        axis[0] = axis[2] == 2 ? 0 : axis[2] + 1;
+        axis[1] = axis[0] == 2 ? 0 : axis[0] + 1;
+        if (perm & 1) std::swap(axis[0], axis[1]);
+    }
+    auto coord = [&](const Vec3& p, int role) {
+        if (perm >= 0) return splat(p[static_cast<std::size_t>(axis[role])]);
+        return pick(L.is_x[role], L.is_y[role], splat(p.x), splat(p.y), splat(p.z));
+    };
+    const F ox = L.role_org[0], oy = L.role_org[1], oz = L.role_org[2];
+    const F a_kz = coord(tri.v0, 2) - oz, b_kz = coord(tri.v1, 2) - oz, c_kz = coord(tri.v2, 2) - oz;
+    const F ax = (coord(tri.v0, 0) - ox) - L.sx * a_kz, ay = (coord(tri.v0, 1) - oy) - L.sy * a_kz;
+    const F bx = (coord(tri.v1, 0) - ox) - L.sx * b_kz, by = (coord(tri.v1, 1) - oy) - L.sy * b_kz;
+    const F cx = (coord(tri.v2, 0) - ox) - L.sx * c_kz, cy = (coord(tri.v2, 1) - oy) - L.sy * c_kz;
     F eu = cx * by - cy * bx;
     F ev = ax * cy - ay * cx;
     F ew = bx * ay - by * ax;
@@ -134,16 +156,12 @@ inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask,
     return hit;
 }
 
-// Runs `fn(perm, lanes)` for each axis permutation present among the lanes of `mask`.
-template <class Fn>
-inline void for_each_perm(const Lanes& L, I mask, Fn&& fn) {
-    unsigned todo = bits(mask);
-    while (todo) {
-        const int p = L.perm[__builtin_ctz(todo)];
-        const I same = mask & (L.perm == p);
-        todo &= ~bits(same);
-        fn(p, same);
-    }
+// The permutation the lanes of `mask` share, or -1 when they differ.
+inline int shared_perm(const Lanes& L, I mask) {
+    const unsigned b = bits(mask);
+    if (!b) return -1;
+    const int p = L.perm[__builtin_ctz(b)];
+    return any(mask & (L.perm != p)) ? -1 : p;
 }
 
 // Closest hit per lane under the hit rule (ray.hpp).
@@ -159,16 +177,14 @@ struct ClosestLanes {
     I finished() const { return splat_i(0); }
 
     void test(const Lanes& L, const Triangle& tri, std::uint32_t prim, I mask) {
-        for_each_perm(L, mask, [&](int p, I lanes) {
-            F t, u, v;
-            const I hit = watertight_lanes(L, p, tri, lanes, t, u, v);
-            const I accept = hit & (t >= L.tnear) & (t <= best_t);
-            const I better = accept & ((t < best_t) | (I)(splat_u(prim) < best_prim));
-            best_t = select(better, t, best_t);
-            best_u = select(better, u, best_u);
-            best_v = select(better, v, best_v);
-            best_prim = select(better, splat_u(prim), best_prim);
-        });
+        F t, u, v;
+        const I hit = watertight_lanes(L, shared_perm(L, mask), tri, mask, t, u, v);
+        const I accept = hit & (t >= L.tnear) & (t <= best_t);
+        const I better = accept & ((t < best_t) | (I)(splat_u(prim) < best_prim));
+        best_t = select(better, t, best_t);
+        best_u = select(better, u, best_u);
+        best_v = select(better, v, best_v);
+        best_prim = select(better, splat_u(prim), best_prim);
     }
 
     void store(const Lanes& L, Hit* out) const {
@@ -188,11 +204,10 @@ struct AnyLanes {
     I finished() const { return occluded; }
 
     void test(const Lanes& L, const Triangle& tri, std::uint32_t, I mask) {
-        for_each_perm(L, mask & ~occluded, [&](int p, I lanes) {
-            F t, u, v;
-            const I hit = watertight_lanes(L, p, tri, lanes, t, u, v);
-            occluded |= hit & (t >= L.tnear) & (t <= L.tfar);
-        });
+        mask &= ~occluded;
+        F t, u, v;
+        const I hit = watertight_lanes(L, shared_perm(L, mask), tri, mask, t, u, v);
+        occluded |= hit & (t >= L.tnear) & (t <= L.tfar);
     }
 
     void store(const Lanes& L, std::uint8_t* out) const {
@@ -323,37 +338,55 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
     }
 }
 
+inline float min_of(F x) {
+    float m = x[0];
+    for (int i = 1; i < kLanes; ++i) m = std::min(m, x[i]);
+    return m;
+}
+inline float max_of(F x) {
+    float m = x[0];
+    for (int i = 1; i < kLanes; ++i) m = std::max(m, x[i]);
+    return m;
+}
+
 // Entry-point search for a whole batch (see the top of this file). Returns the deepest node whose
 // cell contains every ray's traversal, and sets `box` to that cell; the root when the batch is not
 // coherent (invalid rays, mixed direction signs or zero direction components).
 template <class Tree>
-inline std::uint32_t entry_point(const Tree& tree, std::span<const Ray> rays, Box3& box) {
+inline std::uint32_t entry_point(const Tree& tree, std::span<const Lanes> groups, Box3& box) {
     box = tree.bounds;
-    Vec3 olo(kInfinity), ohi(-kInfinity), ilo(kInfinity), ihi(-kInfinity);
-    float tmin = kInfinity, tmax = -kInfinity, margin = 0.f;
-    bool first = true;
-    std::uint32_t signs = 0;
-    for (const Ray& ray : rays) {
-        if (!is_valid(ray)) return 0;
-        const TraversalRay r(ray, tree.bounds);
-        std::uint32_t s = 0;
+    const F inf = splat(kInfinity);
+    F olo[3] = {inf, inf, inf}, ohi[3] = {-inf, -inf, -inf}, ilo[3] = {inf, inf, inf}, ihi[3] = {-inf, -inf, -inf};
+    F tmin_v = inf, tmax_v = -inf, margin_v = splat(0.f);
+    I negative[3] = {splat_i(0), splat_i(0), splat_i(0)}, positive[3] = {splat_i(0), splat_i(0), splat_i(0)};
+    for (const Lanes& g : groups) {
+        I loaded = splat_i(0);
+        for (int i = 0; i < g.count; ++i) loaded[i] = -1;
+        if (any(loaded & ~g.valid)) return 0;
+        F t0, t1;
+        const I hit = clip_lanes(g, tree.bounds, t0, t1);
         for (int a = 0; a < 3; ++a) {
-            if (!(std::fabs(r.inv_dir[a]) < kInfinity) || r.dir[a] == 0.f) return 0;
-            s |= r.dir_neg[a] << a;
+            if (any(g.valid & ~(abs_lanes(g.inv[a]) < kInfinity))) return 0;
+            negative[a] |= g.valid & g.neg[a];
+            positive[a] |= g.valid & ~g.neg[a];
+            olo[a] = select(hit, min_keep(olo[a], g.org[a]), olo[a]);
+            ohi[a] = select(hit, max_keep(ohi[a], g.org[a]), ohi[a]);
+            ilo[a] = select(hit, min_keep(ilo[a], g.inv[a]), ilo[a]);
+            ihi[a] = select(hit, max_keep(ihi[a], g.inv[a]), ihi[a]);
         }
-        if (!first && s != signs) return 0;
-        signs = s;
-        first = false;
-        float t0, t1;
-        if (!r.clip(tree.bounds, t0, t1)) continue;
-        olo = min(olo, r.org);
-        ohi = max(ohi, r.org);
-        ilo = min(ilo, Vec3{r.inv_dir[0], r.inv_dir[1], r.inv_dir[2]});
-        ihi = max(ihi, Vec3{r.inv_dir[0], r.inv_dir[1], r.inv_dir[2]});
-        tmin = std::min(tmin, t0);
-        tmax = std::max(tmax, t1);
-        margin = std::max(margin, r.margin);
+        tmin_v = select(hit, min_keep(tmin_v, t0), tmin_v);
+        tmax_v = select(hit, max_keep(tmax_v, t1), tmax_v);
+        margin_v = select(hit, max_keep(margin_v, g.margin), margin_v);
     }
+    std::uint32_t signs = 0;
+    Vec3 o_lo, o_hi, i_lo, i_hi;
+    for (int a = 0; a < 3; ++a) {
+        if (any(negative[a]) && any(positive[a])) return 0;
+        signs |= (any(negative[a]) ? 1u : 0u) << a;
+        o_lo[a] = min_of(olo[a]), o_hi[a] = max_of(ohi[a]), i_lo[a] = min_of(ilo[a]), i_hi[a] = max_of(ihi[a]);
+    }
+    float tmin = min_of(tmin_v), tmax = max_of(tmax_v);
+    const float margin = max_of(margin_v);
     if (!(tmin <= tmax)) return 0;
     std::uint32_t index = 0;
     for (;;) {
@@ -363,8 +396,8 @@ inline std::uint32_t entry_point(const Tree& tree, std::span<const Ray> rays, Bo
         // Every lane's plane distance (s - o) * inv lies between the products of the interval ends:
         // rounding is monotonic in each operand.
         auto range = [&](float plane, float& lo, float& hi) {
-            const float p[4] = {(plane - olo[a]) * ilo[a], (plane - olo[a]) * ihi[a], (plane - ohi[a]) * ilo[a],
-                                (plane - ohi[a]) * ihi[a]};
+            const float p[4] = {(plane - o_lo[a]) * i_lo[a], (plane - o_lo[a]) * i_hi[a], (plane - o_hi[a]) * i_lo[a],
+                                (plane - o_hi[a]) * i_hi[a]};
             lo = std::min(std::min(p[0], p[1]), std::min(p[2], p[3]));
             hi = std::max(std::max(p[0], p[1]), std::max(p[2], p[3]));
         };
@@ -376,12 +409,12 @@ inline std::uint32_t entry_point(const Tree& tree, std::span<const Ray> rays, Bo
             range(n.clip(0), l_lo, l_hi);
             range(n.clip(1), r_lo, r_hi);
         }
-        const bool negative = (signs >> a) & 1u;
+        const bool negative_dir = (signs >> a) & 1u;
         // Near child ends at its plane, far child starts at its plane (as in split_lanes).
-        const float near_end_hi = negative ? r_hi : l_hi, far_start_lo = negative ? l_lo : r_lo;
+        const float near_end_hi = negative_dir ? r_hi : l_hi, far_start_lo = negative_dir ? l_lo : r_lo;
         const bool near_needed = !(tmin > near_end_hi + margin), far_needed = !(far_start_lo - margin > tmax);
         if (near_needed == far_needed) return index;  // the batch splits here (or passes between planes)
-        const bool left = negative ? far_needed : near_needed;
+        const bool left = negative_dir ? far_needed : near_needed;
         float plane;
         if constexpr (std::is_same_v<std::decay_t<decltype(n)>, KdNode>) plane = n.split();
         else plane = left ? n.clip(0) : n.clip(1);
@@ -392,19 +425,27 @@ inline std::uint32_t entry_point(const Tree& tree, std::span<const Ray> rays, Bo
     }
 }
 
-// A batch through a tree: entry-point search when it is larger than one packet, then kLanes rays at
-// a time from the entry point.
+// A batch through a tree, up to kGroups packets of kLanes rays at a time: loaded, an entry-point search
+// when there is more than one packet, then each packet from the entry point.
+constexpr std::size_t kGroups = 64;
+
 template <class Tree, class Query, class Out>
 inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<const Ray> rays, Out* out,
                         TraversalCounters* counters) {
-    Box3 box = tree.bounds;
-    const std::uint32_t start = rays.size() > static_cast<std::size_t>(kLanes) ? entry_point(tree, rays, box) : 0;
-    for (std::size_t i = 0; i < rays.size(); i += kLanes) {
-        const int n = static_cast<int>(std::min<std::size_t>(kLanes, rays.size() - i));
-        const Lanes L = load_lanes(rays.data() + i, n, tree.bounds);
-        Query q(L);
-        trace_lanes(tree, triangles, L, q, start, box, LaneCounters{counters});
-        q.store(L, out + i);
+    Lanes groups[kGroups];
+    for (std::size_t begin = 0; begin < rays.size(); begin += kGroups * kLanes) {
+        const std::size_t end = std::min(rays.size(), begin + kGroups * kLanes);
+        std::size_t count = 0;
+        for (std::size_t i = begin; i < end; i += kLanes)
+            groups[count++] = load_lanes(rays.data() + i, static_cast<int>(std::min<std::size_t>(kLanes, end - i)),
+                                         tree.bounds);
+        Box3 box = tree.bounds;
+        const std::uint32_t start = count > 1 ? entry_point(tree, std::span<const Lanes>(groups, count), box) : 0;
+        for (std::size_t g = 0; g < count; ++g) {
+            Query q(groups[g]);
+            trace_lanes(tree, triangles, groups[g], q, start, box, LaneCounters{counters});
+            q.store(groups[g], out + begin + g * kLanes);
+        }
     }
     if (counters) counters->rays += rays.size();
 }
