@@ -59,9 +59,20 @@ FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
     return f;
 }
 
-// KIND[:TRAVERSAL][+SIMD], e.g. kd:branched, bih+avx2 (SIMD packets), embree:packet16.
+// KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. kd:branched, bih+avx2 (SIMD packets),
+// embree:packet16, kd+avx512@max_depth=20,leaf_size=2 (build parameters).
 AccelConfig parse_config(std::string text, unsigned threads) {
     AccelConfig c;
+    if (const auto at = text.find('@'); at != std::string::npos) {
+        std::string params = text.substr(at + 1) + ",";
+        text = text.substr(0, at);
+        for (std::size_t b = 0, e; (e = params.find(',', b)) != std::string::npos; b = e + 1) {
+            const std::string kv = params.substr(b, e - b);
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos) throw Error("build parameter '" + kv + "' must be NAME=VALUE");
+            c.params[kv.substr(0, eq)] = kv.substr(eq + 1);
+        }
+    }
     if (const auto plus = text.find('+'); plus != std::string::npos) {
         c.simd = text.substr(plus + 1);
         text = text.substr(0, plus);
@@ -111,7 +122,7 @@ int main(int argc, char** argv) {
     std::string size, json_path, clock = "wall";
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
-    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")->capture_default_str();
+    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...]; the first embree one is the yardstick")->capture_default_str();
     app.add_option("--repeats", repeats, "Timed passes per ray kind (median)")->capture_default_str()->check(CLI::Range(1, 1000));
     app.add_option("--builds", builds, "Timed builds (median)")->capture_default_str()->check(CLI::Range(1, 100));
     app.add_option("--batch", batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));
@@ -150,7 +161,7 @@ int main(int argc, char** argv) {
             results.reserve(configs.size());  // `yardstick` points into it
             const Result* yardstick = nullptr;
             for (const std::string& text : configs) {
-                const AccelConfig cfg = parse_config(text, threads);
+                const AccelConfig cfg = parse_config(text, static_cast<unsigned>(threads));
                 const auto kinds = accelerator_kinds();
                 if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
                     std::fprintf(stderr, "skipping %s: not built into this binary\n", text.c_str());
