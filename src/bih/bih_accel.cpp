@@ -71,7 +71,7 @@ private:
 
 std::unique_ptr<Accelerator> make_bih(std::span<const Triangle> triangles, const AccelConfig& config) {
     const BihBuildParams params = read_params(config);
-    const std::string t = traversal_or_default(config, {"branchless", "branched"}, "bih");
+    const std::string t = traversal_or_default(config, {"branched", "branchless"}, "bih");
     return std::make_unique<BihAccelerator>(triangles, params,
                                             t == "branched" ? BihTraversal::branched : BihTraversal::branchless,
                                             packet_kernels_for(config));

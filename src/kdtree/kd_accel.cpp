@@ -28,7 +28,7 @@ KdBuildParams read_params(const AccelConfig& config) {
 }
 
 KdTraversal read_traversal(const AccelConfig& config) {
-    const std::string t = traversal_or_default(config, {"branchless", "branched", "rec"}, "kd");
+    const std::string t = traversal_or_default(config, {"branched", "rec", "branchless"}, "kd");
     return t == "rec" ? KdTraversal::rec : t == "branched" ? KdTraversal::branched : KdTraversal::branchless;
 }
 
