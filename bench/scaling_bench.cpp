@@ -1,7 +1,9 @@
 // The study's scaling measurement (its Tables 5-1 and 5-2), with Embree alongside: seconds per frame
-// (primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode and packet
-// size. Warm-up frame, then the median of --repeats frames. Writes a Markdown table to stdout and
-// every measurement as CSV and JSON; bench/plot_scaling.py draws the curves.
+// (512 x 512, primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode
+// and packet size. Every point is a warm-up frame and the median of --repeats frames; every table
+// shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
+// and packet size, measured in the same run. Writes Markdown tables to stdout and every point as
+// JSON and CSV; bench/plot_scaling.py draws the curves.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -17,7 +19,6 @@
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
-#include "cellrt/timer.hpp"
 
 namespace {
 
@@ -28,42 +29,59 @@ double median(std::vector<double> v) {
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-AccelConfig parse_config(const std::string& text) {
+// KIND[:TRAVERSAL][+SIMD], as cellrt_bench takes them.
+AccelConfig parse_config(std::string text) {
     AccelConfig c;
+    if (const auto plus = text.find('+'); plus != std::string::npos) {
+        c.simd = text.substr(plus + 1);
+        text = text.substr(0, plus);
+    }
     const auto colon = text.find(':');
     c.kind = text.substr(0, colon);
     if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
-    c.threads = 1;
     return c;
 }
+
+struct Point {
+    std::string scene, config, dispatch;
+    int packet;
+    unsigned workers;
+    double seconds;
+    std::uint64_t rays;
+};
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size"};
+    CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size, Embree alongside"};
     std::string scenes_dir = "../shared/scenes";
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
-    std::vector<std::string> configs{"embree", "kd", "bih"};  // embree first: the others are compared with it
+    std::vector<std::string> configs{"embree:single", "kd+auto", "bih+auto", "kd:branched"};
     std::vector<std::string> dispatches{"pull", "mailbox"};
-    std::vector<int> packets{2, 16};
+    std::vector<int> packets{2, 8, 16};
     std::vector<unsigned> workers;
     int repeats = 3, size = 512;
     std::string csv_path, json_path;
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
-    app.add_option("--configs", configs, "Structures KIND[:TRAVERSAL]")->capture_default_str();
+    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
+        ->capture_default_str();
     app.add_option("--dispatch", dispatches, "Dispatch modes")->capture_default_str();
     app.add_option("--packets", packets, "Packet edges P (P x P rays)")->capture_default_str();
     app.add_option("--workers", workers, "Worker counts (default 1..cores)");
-    app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str();
-    app.add_option("--size", size, "Image edge (square, as in the study)")->capture_default_str();
+    app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str()->check(CLI::Range(1, 100));
+    app.add_option("--size", size, "Image edge (square, as in the study)")->capture_default_str()->check(CLI::Range(1, 16384));
     app.add_option("--csv", csv_path, "Write every point as CSV");
     app.add_option("--json", json_path, "Write every point as JSON");
     CLI11_PARSE(app, argc, argv);
     if (workers.empty())
         for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) workers.push_back(w);
 
-    nlohmann::json points = nlohmann::json::array();
+    std::vector<Point> points;
+    std::vector<std::string> scene_names;
+    std::string yardstick;
+    for (const std::string& c : configs)
+        if (yardstick.empty() && parse_config(c).kind == "embree") yardstick = c;
     try {
         for (const std::string& name : scenes) {
             std::string spec = name;
@@ -75,7 +93,7 @@ int main(int argc, char** argv) {
                 }
             }
             const Scene scene = load_scene(spec);
-            std::map<std::string, double> embree_seconds;  // key: dispatch/packet/workers
+            scene_names.push_back(scene.name);
             for (const std::string& cfg_text : configs) {
                 const AccelConfig cfg = parse_config(cfg_text);
                 const auto kinds = accelerator_kinds();
@@ -84,15 +102,8 @@ int main(int argc, char** argv) {
                     continue;
                 }
                 const auto accel = make_accelerator(scene.triangles, cfg);
-                std::printf("\n### %s, %s\n\n| dispatch | packet |", scene.name.c_str(), cfg_text.c_str());
-                for (unsigned w : workers) std::printf(" %u |", w);
-                std::printf(" efficiency at %u |\n|---|---|", workers.back());
-                for (std::size_t i = 0; i <= workers.size(); ++i) std::printf("---|");
-                std::printf("\n");
                 for (const std::string& d : dispatches)
-                    for (int p : packets) {
-                        std::printf("| %s | %dx%d |", d.c_str(), p, p);
-                        double t1 = 0.0, tn = 0.0;
+                    for (int p : packets)
                         for (unsigned w : workers) {
                             RenderOptions o;
                             o.width = o.height = size;
@@ -101,39 +112,75 @@ int main(int argc, char** argv) {
                             o.dispatch = parse_dispatch(d);
                             render(scene, *accel, o);  // warm-up
                             std::vector<double> times;
+                            RenderStats st;
                             for (int r = 0; r < repeats; ++r) {
-                                RenderStats st;
                                 render(scene, *accel, o, &st);
                                 times.push_back(st.seconds);
                             }
-                            const double t = median(times);
-                            if (w == workers.front()) t1 = t * workers.front();
-                            tn = t;
-                            const std::string key = d + "/" + std::to_string(p) + "/" + std::to_string(w);
-                            if (cfg.kind == "embree") embree_seconds[key] = t;
-                            nlohmann::json pt{{"scene", scene.name}, {"config", cfg_text}, {"dispatch", d},
-                                              {"packet", p},         {"workers", w},       {"seconds", t}};
-                            if (embree_seconds.count(key)) pt["embree_seconds"] = embree_seconds[key];
-                            points.push_back(pt);
-                            std::printf(" %.4f |", t);
-                            std::fflush(stdout);
+                            points.push_back({scene.name, cfg_text, d, p, w, median(times), st.primary_rays + st.shadow_rays});
+                            std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(), cfg_text.c_str(),
+                                         d.c_str(), p, p, w, points.back().seconds);
                         }
-                        std::printf(" %.2f |\n", t1 / (tn * workers.back()));
-                    }
             }
         }
     } catch (const Error& e) {
         std::fprintf(stderr, "cellrt_scaling: error: %s\n", e.what());
         return 1;
     }
-    if (!json_path.empty()) std::ofstream(json_path) << points.dump(1) << "\n";
+
+    auto find = [&](const std::string& scene, const std::string& config, const std::string& d, int p,
+                    unsigned w) -> const Point* {
+        for (const Point& pt : points)
+            if (pt.scene == scene && pt.config == config && pt.dispatch == d && pt.packet == p && pt.workers == w)
+                return &pt;
+        return nullptr;
+    };
+    // One table per configuration, dispatch and packet size, shaped like the study's: rows scenes,
+    // columns workers, seconds per frame with cellrt's rays/s over Embree's; then parallel efficiency.
+    for (const std::string& config : configs)
+        for (const std::string& d : dispatches)
+            for (int p : packets) {
+                std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |",
+                            config.c_str(), d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
+                for (unsigned w : workers) std::printf(" %u |", w);
+                std::printf(" efficiency at %u |\n|---|", workers.back());
+                for (std::size_t i = 0; i <= workers.size(); ++i) std::printf("---|");
+                std::printf("\n");
+                for (const std::string& scene : scene_names) {
+                    std::printf("| %s |", scene.c_str());
+                    const Point* first = find(scene, config, d, p, workers.front());
+                    const Point* last = find(scene, config, d, p, workers.back());
+                    for (unsigned w : workers) {
+                        const Point* pt = find(scene, config, d, p, w);
+                        const Point* y = yardstick.empty() ? nullptr : find(scene, yardstick, d, p, w);
+                        if (!pt) std::printf(" – |");
+                        else if (y) std::printf(" %.4f (%.2f×) |", pt->seconds, y->seconds / pt->seconds);
+                        else std::printf(" %.4f |", pt->seconds);
+                    }
+                    if (first && last)
+                        std::printf(" %.2f |\n", first->seconds * workers.front() / (last->seconds * workers.back()));
+                    else
+                        std::printf(" – |\n");
+                }
+            }
+
+    nlohmann::json out = nlohmann::json::array();
+    for (const Point& pt : points) {
+        nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
+                         {"packet", pt.packet}, {"workers", pt.workers}, {"seconds", pt.seconds},
+                         {"rays", pt.rays}};
+        if (const Point* y = yardstick.empty() ? nullptr : find(pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
+            j["embree_seconds"] = y->seconds;
+        out.push_back(j);
+    }
+    if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
     if (!csv_path.empty()) {
         std::ofstream csv(csv_path);
-        csv << "scene,config,dispatch,packet,workers,seconds\n";
-        for (const auto& p : points)
-            csv << p["scene"].get<std::string>() << ',' << p["config"].get<std::string>() << ','
-                << p["dispatch"].get<std::string>() << ',' << p["packet"] << ',' << p["workers"] << ',' << p["seconds"]
-                << '\n';
+        csv << "scene,config,dispatch,packet,workers,seconds,rays,embree_seconds\n";
+        for (const auto& j : out)
+            csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
+                << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
+                << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
     }
     return 0;
 }

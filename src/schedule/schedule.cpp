@@ -1,8 +1,6 @@
 #include "cellrt/schedule.hpp"
 
 #include <algorithm>
-#include <condition_variable>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -60,38 +58,36 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
     return done.load() == grid.count();
 }
 
-// One worker's single-slot mailbox: the master posts a packet, the worker posts its colours back.
+// One worker's single-slot mailbox, after the Cell's SPU mailboxes: a slot the master writes a packet
+// into and the worker its colours back, each side polling the other's flag. Polling (with a yield, so
+// that an oversubscribed machine still makes progress) models the hardware channel, which costs
+// hundreds of cycles, not an operating-system wake-up.
 struct Mailbox {
-    enum class State { idle, work, done, stop };
-    std::mutex mutex;
-    std::condition_variable to_worker;
-    State state = State::idle;
+    enum State : int { idle, work, done, stop };
+    alignas(64) std::atomic<int> state{idle};
     PixelRect rect{};
     std::vector<Vec3> colours;
 };
 
+// Spins until `ready()` holds, yielding the processor between polls.
+template <class Ready>
+void poll(Ready&& ready) {
+    while (!ready()) std::this_thread::yield();
+}
+
 bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
                  unsigned workers) {
     std::vector<Mailbox> boxes(workers);
-    std::mutex master_mutex;
-    std::condition_variable to_master;
     for (Mailbox& b : boxes) b.colours.resize(static_cast<std::size_t>(grid.packet) * grid.packet);
 
     auto work = [&](unsigned w) {
         Mailbox& box = boxes[w];
         for (;;) {
-            std::unique_lock lock(box.mutex);
-            box.to_worker.wait(lock, [&] { return box.state == Mailbox::State::work || box.state == Mailbox::State::stop; });
-            if (box.state == Mailbox::State::stop) return;
-            const PixelRect r = box.rect;
-            lock.unlock();
-            trace(w, r, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(r.pixels())));
-            {
-                std::lock_guard master_lock(master_mutex);
-                lock.lock();
-                box.state = Mailbox::State::done;
-            }
-            to_master.notify_one();
+            int s;
+            poll([&] { return (s = box.state.load(std::memory_order_acquire)) == Mailbox::work || s == Mailbox::stop; });
+            if (s == Mailbox::stop) return;
+            trace(w, box.rect, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
+            box.state.store(Mailbox::done, std::memory_order_release);
         }
     };
     std::vector<std::thread> pool;
@@ -100,50 +96,33 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
         if (options.pin) pin_to_core(pool.back(), w);
     }
 
-    // The master: collect finished packets into the frame buffer, hand out the next ones.
+    // The master (the study's PPU): keeps the packet counter, posts each packet to an idle worker,
+    // and writes every finished packet's colours into the frame buffer.
     std::size_t next = 0, done = 0, in_flight = 0;
-    auto any_in = [&](Mailbox::State s) {
-        for (Mailbox& b : boxes) {
-            std::lock_guard l(b.mutex);
-            if (b.state == s) return true;
-        }
-        return false;
-    };
     for (;;) {
         const bool more = next < grid.count() && !cancelled(options);
         if (in_flight == 0 && !more) break;
-        {
-            std::unique_lock master_lock(master_mutex);
-            to_master.wait(master_lock, [&] {
-                return any_in(Mailbox::State::done) ||
-                       (next < grid.count() && !cancelled(options) && any_in(Mailbox::State::idle));
-            });
-        }
+        bool progressed = false;
         for (Mailbox& b : boxes) {
-            std::unique_lock l(b.mutex);
-            if (b.state == Mailbox::State::done) {
+            const int s = b.state.load(std::memory_order_acquire);
+            if (s == Mailbox::done) {
                 store(image, b.rect, std::span<const Vec3>(b.colours.data(), static_cast<std::size_t>(b.rect.pixels())));
-                b.state = Mailbox::State::idle;
+                b.state.store(Mailbox::idle, std::memory_order_relaxed);
                 --in_flight;
                 ++done;
+                progressed = true;
                 if (options.progress) options.progress(done, grid.count());
             }
-            if (b.state == Mailbox::State::idle && next < grid.count() && !cancelled(options)) {
+            if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() && !cancelled(options)) {
                 b.rect = grid.rect(next++);
-                b.state = Mailbox::State::work;
+                b.state.store(Mailbox::work, std::memory_order_release);
                 ++in_flight;
-                l.unlock();
-                b.to_worker.notify_one();
+                progressed = true;
             }
         }
+        if (!progressed) std::this_thread::yield();
     }
-    for (Mailbox& b : boxes) {
-        {
-            std::lock_guard l(b.mutex);
-            b.state = Mailbox::State::stop;
-        }
-        b.to_worker.notify_one();
-    }
+    for (Mailbox& b : boxes) b.state.store(Mailbox::stop, std::memory_order_release);
     for (auto& t : pool) t.join();
     return done == grid.count();
 }
