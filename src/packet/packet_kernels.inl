@@ -30,6 +30,7 @@ struct Lanes {
     F role_org[3];
     I valid;        // lanes holding a valid ray
     int count = 0;  // rays loaded (the rest of the lanes are invalid)
+    int shared = -1;  // the permutation all valid lanes share, or -1
 };
 
 inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }
@@ -93,6 +94,11 @@ inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
     L.is_x[1] = select(swap, next_x, after_x), L.is_y[1] = select(swap, next_y, after_y);
     L.is_x[2] = z0, L.is_y[2] = z1;
     for (int r = 0; r < 3; ++r) L.role_org[r] = pick(L.is_x[r], L.is_y[r], o[0], o[1], o[2]);
+    const unsigned valid_bits = bits(L.valid);
+    if (valid_bits) {
+        const int p = L.perm[__builtin_ctz(valid_bits)];
+        L.shared = any(L.valid & (L.perm != p)) ? -1 : p;
+    }
     return L;
 }
 
@@ -158,6 +164,7 @@ inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask,
 
 // The permutation the lanes of `mask` share, or -1 when they differ.
 inline int shared_perm(const Lanes& L, I mask) {
+    if (L.shared >= 0) return L.shared;
     const unsigned b = bits(mask);
     if (!b) return -1;
     const int p = L.perm[__builtin_ctz(b)];
@@ -288,7 +295,8 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
                 const F t_right = (splat(n.clip(1)) - L.org[a]) * L.inv[a];
                 split_lanes(L, a, t_left, t_right, tmin, tmax, active, lmin, lmax, rmin, rmax, left, right);
             }
-            const bool go_left = any(left), go_right = any(right);
+            const unsigned left_bits = bits(left), right_bits = bits(right);
+            const bool go_left = left_bits != 0, go_right = right_bits != 0;
             if (go_left && go_right) {
                 if (right_first(L.neg[a], active)) {
                     stack[sp++] = {n.children(), lmin, lmax, left};
