@@ -1,36 +1,15 @@
 #include "cellrt/builtin.hpp"
 
 #include <charconv>
-#include <cmath>
 #include <string_view>
 
+#include "builtin_generators.hpp"
 #include "cellrt/error.hpp"
-#include "mesh_builder.hpp"
 
 namespace cellrt {
 namespace {
 
-struct BuiltinParams {
-    std::size_t tris = 0;
-    std::uint64_t seed = 1;
-};
-
-// A row of spheres of growing tessellation on a ground plane, with a box: the smallest scene with
-// closed meshes, shadows and sky.
-void make_spheres(Scene& scene, const BuiltinParams& p) {
-    detail::MeshBuilder mesh(scene.triangles);
-    mesh.quad({-6.f, 0.f, -6.f}, {-6.f, 0.f, 6.f}, {6.f, 0.f, 6.f}, {6.f, 0.f, -6.f});
-    mesh.box({2.f, 0.f, -3.f}, {3.5f, 1.5f, -1.5f});
-    // Five spheres share the triangle budget: segments = 2 * rings, about 4 * rings^2 triangles each.
-    const double per_sphere = std::max<double>(16.0, static_cast<double>(p.tris) / 5.0);
-    const int rings = std::max(3, static_cast<int>(std::sqrt(per_sphere / 4.0)));
-    for (int i = 0; i < 5; ++i) {
-        const float x = -4.f + 2.f * static_cast<float>(i);
-        mesh.sphere({x, 0.8f, 1.f}, 0.8f, 2 * rings, rings);
-    }
-    scene.camera = {{0.f, 4.f, 9.f}, {0.f, 0.8f, 0.f}, {0.f, 1.f, 0.f}, 50.f};
-    scene.light = {{-3.f, 8.f, 4.f}, {1.f, 1.f, 1.f}};
-}
+using detail::BuiltinParams;
 
 struct Generator {
     const char* name;
@@ -40,7 +19,11 @@ struct Generator {
 };
 
 constexpr Generator kGenerators[] = {
-    {"spheres", "five tessellated spheres and a box on a ground plane", 4000, &make_spheres},
+    {"city", "blocks of box buildings on a ground plane, seen from a street (stands in for the study's CITY)",
+     100'000, &detail::make_city},
+    {"forest", "small detailed trees of cones and leaf triangles on hilly terrain (stands in for FFOREST)", 200'000,
+     &detail::make_forest},
+    {"spheres", "five tessellated spheres and a box on a ground plane", 4000, &detail::make_spheres},
 };
 
 std::uint64_t parse_unsigned(std::string_view value, const std::string& spec, std::string_view key) {
@@ -59,7 +42,7 @@ std::vector<BuiltinInfo> builtin_scenes() {
     return out;
 }
 
-std::string default_scene_spec() { return "builtin:spheres"; }
+std::string default_scene_spec() { return "builtin:city"; }
 
 Scene make_builtin_scene(const std::string& spec) {
     std::string_view rest = std::string_view(spec).substr(std::string_view("builtin:").size());

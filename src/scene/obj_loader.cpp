@@ -10,22 +10,14 @@
 
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
+#include "parse_number.hpp"
 #include "read_file.hpp"
+#include "text_tokens.hpp"
 
 namespace cellrt {
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view next_token(std::string_view& line) {
-    std::size_t b = 0;
-    while (b < line.size() && is_space(line[b])) ++b;
-    std::size_t e = b;
-    while (e < line.size() && !is_space(line[e])) ++e;
-    std::string_view tok = line.substr(b, e - b);
-    line.remove_prefix(e);
-    return tok;
-}
+using detail::next_token;
 
 class ObjParser {
 public:
@@ -54,10 +46,11 @@ private:
 
     float parse_float(std::string_view tok) const {
         float value = 0.f;
-        const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
-        if (ec != std::errc() || ptr != tok.data() + tok.size())
+        const detail::ParsedNumber parsed = detail::parse_number(tok, value);
+        if (parsed == detail::ParsedNumber::Malformed)
             fail("malformed number '" + std::string(tok) + "' in vertex", line_);
-        if (!std::isfinite(value)) fail("vertex coordinate '" + std::string(tok) + "' is not finite", line_);
+        if (parsed == detail::ParsedNumber::OutOfRange || !std::isfinite(value))
+            fail("vertex coordinate '" + std::string(tok) + "' is not finite", line_);
         return value;
     }
 

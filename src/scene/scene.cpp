@@ -58,7 +58,8 @@ void validate_scene(const Scene& scene, const std::string& where) {
 std::vector<Triangle> load_mesh(const std::string& path) {
     const std::string ext = lower_extension(path);
     if (ext == ".obj") return load_obj(path);
-    throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj)");
+    if (ext == ".ply") return load_ply(path);
+    throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj or .ply)");
 }
 
 Scene load_scene(const std::string& spec) {

@@ -63,6 +63,7 @@ public:
         if (!mesh.is_string() || mesh.get<std::string>().empty()) fail("mesh", "must be a non-empty string");
         const std::filesystem::path mesh_path =
             std::filesystem::path(path_).parent_path() / mesh.get<std::string>();
+        if (!std::filesystem::exists(mesh_path)) fail("mesh", "names " + mesh_path.string() + ", which does not exist");
 
         Scene scene;
         scene.name = doc.contains("name") && doc["name"].is_string()
