@@ -61,6 +61,32 @@ FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
 
 // KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. kd:branched, bih+avx2 (SIMD packets),
 // embree:packet16, kd+avx512@max_depth=20,leaf_size=2 (build parameters).
+// Incoherent rays, for the packet kernels' worst case: origins uniform in the scene's box,
+// directions uniform on the sphere; the same rays (with tfar a third of the box's diagonal) serve as
+// "shadow" rays. Deterministic (SplitMix64).
+FrameRays random_rays(const Scene& scene, std::size_t n) {
+    const Box3 b = scene.bounds();
+    std::uint64_t state = 0x9e3779b97f4a7c15ull;
+    auto next = [&] {
+        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return static_cast<float>((z ^ (z >> 31)) >> 40) / static_cast<float>(1 << 24);
+    };
+    FrameRays f;
+    while (f.primary.size() < n) {
+        Ray r;
+        for (int a = 0; a < 3; ++a) r.org[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * next();
+        const Vec3 d{2.f * next() - 1.f, 2.f * next() - 1.f, 2.f * next() - 1.f};
+        if (dot(d, d) > 1.f || dot(d, d) < 1e-6f) continue;
+        r.dir = normalize(d);
+        f.primary.push_back(r);
+        r.tfar = length(b.extent()) / 3.f;
+        f.shadow.push_back(r);
+    }
+    return f;
+}
+
 AccelConfig parse_config(std::string text, unsigned threads) {
     AccelConfig c;
     if (const auto at = text.find('@'); at != std::string::npos) {
@@ -119,7 +145,7 @@ int main(int argc, char** argv) {
                                      "bih:branchless"};
     int repeats = 5, builds = 3, batch = 256;
     unsigned threads = 1;
-    std::string size, json_path, clock = "wall";
+    std::string size, json_path, clock = "wall", ray_kind = "frame";
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
     app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...]; the first embree one is the yardstick")->capture_default_str();
@@ -129,6 +155,9 @@ int main(int argc, char** argv) {
     app.add_option("--threads", threads, "Build threads (tracing is single-threaded)")->capture_default_str();
     app.add_option("--size", size, "Image size WxH (default: the view file's)");
     app.add_option("--json", json_path, "Write every result as JSON");
+    app.add_option("--rays", ray_kind, "frame: a frame's primary and shadow rays; random: incoherent rays")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"frame", "random"}));
     app.add_option("--clock", clock, "Time tracing by the wall clock or this thread's CPU clock")
         ->capture_default_str()
         ->check(CLI::IsMember({"wall", "cpu"}));
@@ -148,7 +177,8 @@ int main(int argc, char** argv) {
             const Scene scene = load_scene(spec);
             int w = scene.width, h = scene.height;
             if (!size.empty() && std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2) throw Error("--size must be WxH");
-            const FrameRays rays = frame_rays(scene, w, h, 16);
+            const FrameRays rays = ray_kind == "frame" ? frame_rays(scene, w, h, 16)
+                                                       : random_rays(scene, static_cast<std::size_t>(w) * h);
             std::vector<Hit> exact(rays.primary.size());
             make_accelerator(scene.triangles, AccelConfig{"kd"})->intersect(rays.primary, exact);
 
