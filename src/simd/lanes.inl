@@ -34,7 +34,8 @@ inline bool any(I m) { return bits(m) != 0; }
 // IEEE square root lane by lane (correctly rounded, so equal to std::sqrt).
 inline F sqrt_lanes(F x) {
 #if defined(CELLRT_SIMD_AVX512)
-    return reinterpret_cast<F>(_mm512_sqrt_ps(reinterpret_cast<__m512>(x)));
+    // The masked form: GCC 12's unmasked one reads an uninitialised vector (harmlessly) and warns.
+    return reinterpret_cast<F>(_mm512_mask_sqrt_ps(reinterpret_cast<__m512>(x), 0xffff, reinterpret_cast<__m512>(x)));
 #elif defined(CELLRT_SIMD_AVX2)
     return reinterpret_cast<F>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
 #elif defined(CELLRT_SIMD_SSE)
