@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
                  "architecture' (M. Hapala)"};
     app.require_subcommand(0, 1);
     // The first command is the default: `cellrt` alone renders the default scene.
-    const std::vector<cli::Runner> runners = {cli::add_render(app), cli::add_info(app)};
+    const std::vector<cli::Runner> runners = {cli::add_render(app), cli::add_info(app), cli::add_profile(app),
+                                              cli::add_cache_study(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

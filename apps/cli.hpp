@@ -50,8 +50,6 @@ void print_stats(const AccelStats& s);
 // WIDTHxHEIGHT, both in [1, 65536]; throws cellrt::Error naming the option otherwise.
 std::pair<int, int> parse_size(const std::string& option, const std::string& text);
 
-// Writes `text` beside `path` and renames it into place; replaces an existing file only with `overwrite`.
-void write_text_file(const std::string& path, const std::string& text, bool overwrite);
 
 // A one-line progress bar on stderr, shown only on a terminal and only once a render has run for a
 // second.

@@ -1,12 +1,134 @@
-// `cellrt render [SCENE] ...`: one primary ray per pixel and one shadow ray per hit, to PNG or PFM.
+// `cellrt render [SCENE] ...`: one primary ray per pixel and one shadow ray per hit, to PNG or PFM;
+// with --local-store through the local-store model (docs/LOCALSTORE.md), whose cache statistics and
+// modelled cycles are printed at the end.
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 
+#include "localstore/local_store.hpp"
 #include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
 
 namespace cellrt::cli {
+namespace {
+
+// --local-store and the options that configure it.
+struct LocalStoreOptions {
+    bool enabled = false;
+    std::string node_cache = LocalStoreConfig{}.node_cache.to_string();
+    std::string tri_cache = LocalStoreConfig{}.triangle_cache.to_string();
+    std::string access = "sync";
+    bool no_retouch = false;
+    int kib = static_cast<int>(LocalStoreConfig{}.budget_bytes / 1024);
+    std::vector<CLI::Option*> dependent;  // options that mean nothing without --local-store
+
+    void add_to(CLI::App& cmd) {
+        cmd.add_flag("--local-store", enabled, "Trace through the local-store model: software caches in a per-worker "
+                                               "local store, modelled cycles (docs/LOCALSTORE.md)");
+        dependent = {
+            cmd.add_option("--node-cache", node_cache, "Node cache LINExSETS[xWAYS]: line 16..4096 B, sets a power "
+                                                       "of two, ways 1 or 4")
+                ->capture_default_str(),
+            cmd.add_option("--tri-cache", tri_cache, "Triangle cache LINExSETS[xWAYS]")->capture_default_str(),
+            cmd.add_option("--cache-access", access, "sync (stall on a miss) or async (touch children, wait later)")
+                ->capture_default_str(),
+            cmd.add_flag("--no-retouch", no_retouch, "async: wait without touching again (shows the study's "
+                                                     "stale-line artifact)"),
+            cmd.add_option("--local-store-kib", kib, "Local store budget in KiB (16..16384)")->capture_default_str(),
+        };
+    }
+
+    // The model's configuration for packets of `packet` x `packet` rays; throws naming the option at fault.
+    LocalStoreConfig config(int packet) const {
+        if (!enabled) {
+            for (const CLI::Option* opt : dependent)
+                if (opt->count() > 0) throw Error(opt->get_name() + " needs --local-store");
+            return {};
+        }
+        LocalStoreConfig c;
+        c.node_cache = parse_cache_layout("--node-cache", node_cache);
+        c.triangle_cache = parse_cache_layout("--tri-cache", tri_cache);
+        c.access = parse_cache_access("--cache-access", access);
+        if (no_retouch && c.access != CacheAccess::async) throw Error("--no-retouch needs --cache-access async");
+        c.retouch = !no_retouch;
+        if (kib < 16 || kib > 16384)
+            throw Error("--local-store-kib " + std::to_string(kib) + " must lie in [16, 16384]");
+        c.budget_bytes = static_cast<std::size_t>(kib) * 1024;
+        if (packet < 1 || packet > 256) throw Error("--packet " + std::to_string(packet) + " must lie in [1, 256]");
+        c.packet_rays = static_cast<std::size_t>(packet) * packet;
+        return c;
+    }
+};
+
+double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
+
+void print_cache(const char* name, const CacheLayout& layout, const CacheStats& s) {
+    std::printf("  %-15s %-9s %6.2f %% hits (%llu hits, %llu misses, %llu prefetches), %.2f MiB in, %llu evictions, "
+                "%llu stale waits\n",
+                name, layout.to_string().c_str(), 100.0 * s.hit_ratio(), static_cast<unsigned long long>(s.hits),
+                static_cast<unsigned long long>(s.misses), static_cast<unsigned long long>(s.prefetches), mib(s.bytes),
+                static_cast<unsigned long long>(s.evictions), static_cast<unsigned long long>(s.stale_waits));
+}
+
+void print_local_store(const LocalStoreAccelerator& accel) {
+    const LocalStoreConfig& c = accel.local_store_config();
+    const LocalStoreStats s = accel.local_store_stats();
+    std::size_t used = 0;
+    for (const auto& a : accel.local_store_allocations()) used += a.bytes;
+    std::printf("local store: %zu of %zu bytes used, %s access%s, %u worker(s), %llu rays in %llu packets\n", used,
+                c.budget_bytes, to_string(c.access),
+                c.access == CacheAccess::async && !c.retouch ? " without re-touch" : "",
+                s.workers, static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.packets));
+    print_cache("node cache", c.node_cache, s.node_cache);
+    print_cache("triangle cache", c.triangle_cache, s.triangle_cache);
+    std::printf("  modelled        %llu cycles (%.2f cycles/ray, %.1f %% waiting for transfers): %.3f ms at %.1f GHz "
+                "on one worker, %.3f ms for the busiest of %u\n",
+                static_cast<unsigned long long>(s.cycles), s.cycles_per_ray(),
+                s.cycles ? 100.0 * static_cast<double>(s.stall_cycles) / static_cast<double>(s.cycles) : 0.0,
+                1e3 * c.cost.seconds(s.cycles), c.cost.clock_ghz, 1e3 * c.cost.seconds(s.frame_cycles), s.workers);
+}
+
+nlohmann::json cache_json(const CacheLayout& layout, const CacheStats& s) {
+    return {{"layout", layout.to_string()}, {"line_bytes", layout.line_bytes}, {"sets", layout.sets},
+            {"ways", layout.ways},          {"hit_ratio", s.hit_ratio()},      {"hits", s.hits},
+            {"misses", s.misses},           {"prefetches", s.prefetches},      {"touch_hits", s.touch_hits},
+            {"bytes", s.bytes},             {"evictions", s.evictions},        {"stale_waits", s.stale_waits}};
+}
+
+nlohmann::json local_store_json(const LocalStoreAccelerator& accel) {
+    const LocalStoreConfig& c = accel.local_store_config();
+    const LocalStoreStats s = accel.local_store_stats();
+    nlohmann::json allocations = nlohmann::json::array();
+    for (const auto& a : accel.local_store_allocations()) allocations.push_back({{"what", a.what}, {"bytes", a.bytes}});
+    const CostModel& m = c.cost;
+    return {{"budget_bytes", c.budget_bytes},
+            {"allocations", allocations},
+            {"access", to_string(c.access)},
+            {"retouch", c.retouch},
+            {"node_cache", cache_json(c.node_cache, s.node_cache)},
+            {"triangle_cache", cache_json(c.triangle_cache, s.triangle_cache)},
+            {"workers", s.workers},
+            {"rays", s.rays},
+            {"packets", s.packets},
+            {"cycles", s.cycles},
+            {"stall_cycles", s.stall_cycles},
+            {"busiest_worker_cycles", s.frame_cycles},
+            {"cycles_per_ray", s.cycles_per_ray()},
+            {"modelled_seconds_one_worker", m.seconds(s.cycles)},
+            {"modelled_seconds_busiest_worker", m.seconds(s.frame_cycles)},
+            {"cost_model",
+             {{"clock_ghz", m.clock_ghz}, {"dma_latency", m.dma_latency}, {"bytes_per_cycle", m.bytes_per_cycle},
+              {"dma_queue", m.dma_queue}, {"ls_access", m.ls_access}, {"cache_lookup", m.cache_lookup},
+              {"miss_handling", m.miss_handling}, {"ray_setup", m.ray_setup}, {"inner_node", m.inner_node},
+              {"leaf", m.leaf}, {"triangle_test", m.triangle_test}, {"branch_miss", m.branch_miss},
+              {"branched_miss_rate", m.branched_miss_rate}, {"branchless_extra", m.branchless_extra}}}};
+}
+
+}  // namespace
 
 Runner add_render(CLI::App& app) {
     struct Options {
@@ -15,6 +137,8 @@ Runner add_render(CLI::App& app) {
         bool overwrite = false, pin = false;
         int packet = RenderOptions{}.packet;
         AccelOptions accel;
+        LocalStoreOptions local_store;
+        std::string stats;
     };
     auto o = std::make_shared<Options>();
     auto* cmd = app.add_subcommand("render", "Render a scene to an image (primary + one shadow ray per hit)");
@@ -28,7 +152,10 @@ Runner add_render(CLI::App& app) {
                                                "study's master)")
         ->capture_default_str();
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i");
+    o->local_store.add_to(*cmd);
+    cmd->add_option("--stats", o->stats, "Write the run's figures (and the local store's) as JSON to FILE");
     return [o] {
+        const LocalStoreConfig local_store = o->local_store.config(o->packet);
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         const double load_s = load_timer.seconds();
@@ -41,17 +168,38 @@ Runner add_render(CLI::App& app) {
         ro.dispatch = parse_dispatch(o->dispatch);
         ro.pin = o->pin;
         ro.cancel = &g_cancel;
-        const auto accel = make_accelerator(scene.triangles, o->accel.config());
+        std::unique_ptr<LocalStoreAccelerator> modelled;
+        if (o->local_store.enabled) {
+            // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
+            AccelConfig config = o->accel.config();
+            if (o->accel.simd_option->count() == 0) config.simd = "off";
+            modelled = make_local_store_accelerator(scene.triangles, config, local_store);
+        }
+        const std::unique_ptr<Accelerator> direct =
+            modelled ? nullptr : make_accelerator(scene.triangles, o->accel.config());
+        const Accelerator& accel = modelled ? *modelled : *direct;
         Progress progress;
         ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };
         RenderStats rs;
-        const Image image = render(scene, *accel, ro, &rs);
+        const Image image = render(scene, accel, ro, &rs);
         write_image(image, o->out, o->overwrite);
-        const AccelStats st = accel->stats();
+        const AccelStats st = accel.stats();
         std::printf("%s: %zu triangles, %dx%d, %s, load %.3f s, build %.3f s, render %.3f s (%.2f Mrays/s) -> %s\n",
                     scene.name.c_str(), scene.triangles.size(), ro.width, ro.height, st.name.c_str(), load_s,
                     st.build_seconds, rs.seconds,
                     static_cast<double>(rs.primary_rays + rs.shadow_rays) / rs.seconds * 1e-6, o->out.c_str());
+        if (modelled) print_local_store(*modelled);
+        if (!o->stats.empty()) {
+            nlohmann::json j = {{"scene", scene.name},          {"triangles", scene.triangles.size()},
+                                {"width", ro.width},            {"height", ro.height},
+                                {"structure", st.name},         {"threads", ro.threads},
+                                {"packet", ro.packet},          {"primary_rays", rs.primary_rays},
+                                {"shadow_rays", rs.shadow_rays}, {"build_seconds", st.build_seconds},
+                                {"render_seconds", rs.seconds}, {"figures", nlohmann::json::object()}};
+            for (const auto& [k, v] : st.figures) j["figures"][k] = v;
+            if (modelled) j["local_store"] = local_store_json(*modelled);
+            write_file_atomically(o->stats, j.dump(1) + "\n", o->overwrite);
+        }
         return 0;
     };
 }

@@ -1,13 +1,11 @@
 #include "bih_accel.hpp"
 
-#include "bih_traversal.hpp"
-#include "packet/packet.hpp"
 #include "cellrt/timer.hpp"
+#include "packet/packet.hpp"
 
 namespace cellrt::detail {
-namespace {
 
-BihBuildParams read_params(const AccelConfig& config) {
+BihBuildParams read_bih_params(const AccelConfig& config) {
     ParamReader in(config, "bih");
     BihBuildParams p;
     p.leaf_size = in.get_int("leaf_size", p.leaf_size, 1, 1 << 20);
@@ -17,6 +15,17 @@ BihBuildParams read_params(const AccelConfig& config) {
     in.finish();
     return p;
 }
+
+const std::vector<std::string>& bih_traversal_names() {
+    static const std::vector<std::string> names{"branched", "branchless"};
+    return names;
+}
+
+BihTraversal bih_traversal(const std::string& name) {
+    return name == "branched" ? BihTraversal::branched : BihTraversal::branchless;
+}
+
+namespace {
 
 class BihAccelerator final : public Accelerator {
 public:
@@ -70,11 +79,9 @@ private:
 }  // namespace
 
 std::unique_ptr<Accelerator> make_bih(std::span<const Triangle> triangles, const AccelConfig& config) {
-    const BihBuildParams params = read_params(config);
-    const std::string t = traversal_or_default(config, {"branched", "branchless"}, "bih");
-    return std::make_unique<BihAccelerator>(triangles, params,
-                                            t == "branched" ? BihTraversal::branched : BihTraversal::branchless,
-                                            packet_kernels_for(config));
+    const BihBuildParams params = read_bih_params(config);
+    const BihTraversal traversal = bih_traversal(traversal_or_default(config, bih_traversal_names(), "bih"));
+    return std::make_unique<BihAccelerator>(triangles, params, traversal, packet_kernels_for(config));
 }
 
 }  // namespace cellrt::detail

@@ -1,13 +1,11 @@
 #include "kd_accel.hpp"
 
 #include "cellrt/timer.hpp"
-#include "kd_traversal.hpp"
 #include "packet/packet.hpp"
 
 namespace cellrt::detail {
-namespace {
 
-KdBuildParams read_params(const AccelConfig& config) {
+KdBuildParams read_kd_params(const AccelConfig& config) {
     ParamReader in(config, "kd");
     KdBuildParams p;
     p.traversal_cost = in.get_number("traversal_cost", p.traversal_cost, 1e-6, 1e6);
@@ -27,10 +25,16 @@ KdBuildParams read_params(const AccelConfig& config) {
     return p;
 }
 
-KdTraversal read_traversal(const AccelConfig& config) {
-    const std::string t = traversal_or_default(config, {"branched", "rec", "branchless"}, "kd");
-    return t == "rec" ? KdTraversal::rec : t == "branched" ? KdTraversal::branched : KdTraversal::branchless;
+const std::vector<std::string>& kd_traversal_names() {
+    static const std::vector<std::string> names{"branched", "rec", "branchless"};
+    return names;
 }
+
+KdTraversal kd_traversal(const std::string& name) {
+    return name == "rec" ? KdTraversal::rec : name == "branched" ? KdTraversal::branched : KdTraversal::branchless;
+}
+
+namespace {
 
 const char* name(KdTraversal t) {
     return t == KdTraversal::rec ? "rec" : t == KdTraversal::branched ? "branched" : "branchless";
@@ -88,8 +92,8 @@ private:
 }  // namespace
 
 std::unique_ptr<Accelerator> make_kdtree(std::span<const Triangle> triangles, const AccelConfig& config) {
-    const KdBuildParams params = read_params(config);
-    const KdTraversal traversal = read_traversal(config);
+    const KdBuildParams params = read_kd_params(config);
+    const KdTraversal traversal = kd_traversal(traversal_or_default(config, kd_traversal_names(), "kd"));
     return std::make_unique<KdAccelerator>(triangles, params, traversal, packet_kernels_for(config));
 }
 

@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include <stb_image_write.h>
 
 #include "cellrt/error.hpp"
+#include "cellrt/files.hpp"
 
 namespace cellrt {
 namespace {
@@ -61,29 +61,7 @@ void write_image(const Image& image, const std::string& path, bool overwrite) {
     else if (ext == ".pfm") bytes = encode_pfm(image);
     else throw Error(path + ": unknown image format '" + ext + "' (use .png or .pfm)");
 
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (!overwrite && fs::exists(path, ec))
-        throw Error(path + ": file exists (pass --overwrite to replace it)");
-    const fs::path target(path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");
-    const fs::path temp = dir / ("." + target.filename().string() + ".part" + std::to_string(::getpid()));
-    {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out) throw Error(path + ": cannot write in '" + dir.string() + "'");
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        out.close();
-        if (!out) {
-            fs::remove(temp, ec);
-            throw Error(path + ": write failed (disk full?)");
-        }
-    }
-    fs::rename(temp, target, ec);
-    if (ec) {
-        fs::remove(temp, ec);
-        throw Error(path + ": cannot move the finished file into place");
-    }
+    write_file_atomically(path, bytes, overwrite);
 }
 
 Image read_pfm(const std::string& path) {

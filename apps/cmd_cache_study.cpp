@@ -1,0 +1,326 @@
+// `cellrt cache-study SCENE... [-o DIR]`: the study's cache experiments (Hapala, section 5.2, Graphs
+// 5-1 to 5-10) through the local-store model. For every scene, structure (kd, bih), traversal
+// (branched, branchless) and access (sync, async), it sweeps the node cache's layout with the triangle
+// cache fixed at 128 B x 128 sets (as the study did), then the triangle cache's layout with the node
+// cache at the study's best for the structure, and writes one CSV row per run: hit ratios, bytes
+// moved, modelled cycles, wall time. bench/plot_cache_study.py draws the graphs from the CSV; the best
+// layouts are compared with the study's in best_layouts.md (docs/LOCALSTORE.md discusses them).
+//
+// Rays: those of one frame as the renderer traces them, packet by packet (primary rays, then the
+// shadow rays of their hits), of a sample of the packets: those whose column + row is a multiple of
+// --sample. Each run is one worker tracing the sample in order, so its figures are reproducible;
+// runs are spread over --threads threads.
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <thread>
+#include <unistd.h>
+
+#include "localstore/local_store.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/files.hpp"
+#include "cellrt/render.hpp"
+#include "cellrt/scene.hpp"
+#include "cli.hpp"
+
+namespace cellrt::cli {
+namespace {
+
+// Layouts swept for one cache: lines of 16 B to 4 KiB for several numbers of sets, direct-mapped and
+// 4-way, up to the study's largest cache, 16 KiB. The sets include the study's best layouts (kd nodes
+// 128 x 128, BIH nodes 256 x 64, triangles 1024 x 16).
+std::vector<CacheLayout> swept_layouts() {
+    constexpr std::size_t kMaxCapacity = 16 * 1024;
+    std::vector<CacheLayout> out;
+    const std::pair<std::uint32_t, std::vector<std::uint32_t>> families[] = {{1, {4, 16, 64, 128, 256}},
+                                                                             {4, {1, 4, 16, 32}}};
+    for (const auto& [ways, sets_list] : families)
+        for (std::uint32_t sets : sets_list)
+            for (std::uint32_t line = CacheLayout::kMinLine; line <= CacheLayout::kMaxLine; line *= 2)
+                if (CacheLayout{line, sets, ways}.capacity() <= kMaxCapacity) out.push_back({line, sets, ways});
+    return out;
+}
+
+// The study's best layouts (section 5.2), each 16 KiB direct-mapped.
+CacheLayout study_node_layout(const std::string& structure) {
+    return structure == "kd" ? CacheLayout{128, 128, 1} : CacheLayout{256, 64, 1};
+}
+constexpr CacheLayout kStudyTriangleLayout{1024, 16, 1};
+// The triangle cache while the node cache is swept, as in the study.
+constexpr CacheLayout kFixedTriangleLayout{128, 128, 1};
+
+// The sampled packets of one frame: primary rays and the shadow rays of their hits, packet by packet.
+struct Workload {
+    struct Packet {
+        std::size_t primary, primary_count, shadow, shadow_count;
+    };
+    std::vector<Packet> packets;
+    std::vector<Ray> primary, shadow;
+    std::size_t frame_packets = 0;
+    std::uint64_t frame_rays = 0;  // primary and shadow rays of the whole frame
+};
+
+Workload sampled_frame(const Scene& scene, int width, int height, int packet, int sample) {
+    const PinholeCamera camera(scene.camera, width, height);
+    const PacketGrid grid(width, height, packet);
+    const auto exact = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    Workload w;
+    w.frame_packets = grid.count();
+    std::vector<Ray> rays, shadow;
+    std::vector<Hit> hits;
+    for (std::size_t p = 0; p < grid.count(); ++p) {
+        const PixelRect r = grid.rect(p);
+        rays.clear();
+        shadow.clear();
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) rays.push_back(camera.primary(x, y));
+        hits.resize(rays.size());
+        exact->intersect(rays, hits);
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            if (hits[i].is_hit()) {
+                const SurfacePoint sp = surface_point(scene.triangles[hits[i].prim], rays[i], hits[i]);
+                shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
+            }
+        w.frame_rays += rays.size() + shadow.size();
+        const std::size_t column = p % static_cast<std::size_t>(grid.columns()), row = p / grid.columns();
+        if ((column + row) % static_cast<std::size_t>(sample) != 0) continue;
+        w.packets.push_back({w.primary.size(), rays.size(), w.shadow.size(), shadow.size()});
+        w.primary.insert(w.primary.end(), rays.begin(), rays.end());
+        w.shadow.insert(w.shadow.end(), shadow.begin(), shadow.end());
+    }
+    return w;
+}
+
+struct Run {
+    std::string structure, traversal, sweep;  // sweep: "node" or "triangle", the cache whose layout varies
+    LocalStoreConfig config;
+};
+
+struct Result {
+    LocalStoreStats stats;
+    double wall_seconds = 0.0;
+};
+
+Result trace(const LocalStoreAccelerator& base, const Run& run, const Workload& w) {
+    const auto accel = base.with_local_store(run.config, run.traversal);
+    std::vector<Hit> hits;
+    std::vector<std::uint8_t> occluded;
+    Timer timer;
+    for (const Workload::Packet& p : w.packets) {
+        hits.resize(p.primary_count);
+        accel->intersect(std::span(w.primary).subspan(p.primary, p.primary_count), hits);
+        occluded.resize(p.shadow_count);
+        accel->occluded(std::span(w.shadow).subspan(p.shadow, p.shadow_count), occluded);
+    }
+    return {accel->local_store_stats(), timer.seconds()};
+}
+
+// Runs every run on `threads` threads, each run on one thread; results in the order of `runs`.
+std::vector<Result> trace_all(const std::map<std::string, std::unique_ptr<LocalStoreAccelerator>>& bases,
+                              const std::vector<Run>& runs, const Workload& w, unsigned threads) {
+    std::vector<Result> results(runs.size());
+    std::atomic<std::size_t> next{0}, done{0};
+    std::atomic<bool> failed{false};
+    std::string failure;
+    Progress progress;
+    auto work = [&] {
+        for (std::size_t i = next++; i < runs.size() && !failed && !g_cancel; i = next++) {
+            try {
+                results[i] = trace(*bases.at(runs[i].structure), runs[i], w);
+            } catch (const Error& e) {
+                if (!failed.exchange(true)) failure = e.what();
+                return;
+            }
+            progress(++done, runs.size());
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+    for (auto& t : pool) t.join();
+    if (failed) throw Error(failure);
+    if (g_cancel) throw Error("cache study cancelled");
+    return results;
+}
+
+std::string csv_header() {
+    return "scene,structure,traversal,access,sweep,node_layout,node_line,node_sets,node_ways,tri_layout,tri_line,"
+           "tri_sets,tri_ways,rays,node_hits,node_misses,node_hit_ratio,node_prefetches,node_bytes,node_evictions,"
+           "tri_hits,tri_misses,tri_hit_ratio,tri_bytes,tri_evictions,cycles,stall_cycles,cycles_per_ray,"
+           "frame_ms,wall_s\n";
+}
+
+std::string csv_row(const std::string& scene, const Run& run, const Result& r, std::uint64_t frame_rays) {
+    const LocalStoreConfig& c = run.config;
+    const LocalStoreStats& s = r.stats;
+    const CacheStats &n = s.node_cache, &t = s.triangle_cache;
+    const double frame_ms = s.cycles_per_ray() * static_cast<double>(frame_rays) / (c.cost.clock_ghz * 1e6);
+    char buf[1024];
+    std::snprintf(buf, sizeof buf,
+                  "%s,%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%.6f,%llu,%llu,%llu,%llu,%llu,%.6f,%llu,%llu,"
+                  "%llu,%llu,%.3f,%.4f,%.4f\n",
+                  scene.c_str(), run.structure.c_str(), run.traversal.c_str(), to_string(c.access), run.sweep.c_str(),
+                  c.node_cache.to_string().c_str(), c.node_cache.line_bytes, c.node_cache.sets, c.node_cache.ways,
+                  c.triangle_cache.to_string().c_str(), c.triangle_cache.line_bytes, c.triangle_cache.sets,
+                  c.triangle_cache.ways, static_cast<unsigned long long>(s.rays),
+                  static_cast<unsigned long long>(n.hits), static_cast<unsigned long long>(n.misses), n.hit_ratio(),
+                  static_cast<unsigned long long>(n.prefetches), static_cast<unsigned long long>(n.bytes),
+                  static_cast<unsigned long long>(n.evictions), static_cast<unsigned long long>(t.hits),
+                  static_cast<unsigned long long>(t.misses), t.hit_ratio(), static_cast<unsigned long long>(t.bytes),
+                  static_cast<unsigned long long>(t.evictions), static_cast<unsigned long long>(s.cycles),
+                  static_cast<unsigned long long>(s.stall_cycles), s.cycles_per_ray(), frame_ms, r.wall_seconds);
+    return buf;
+}
+
+// One line of best_layouts.md: the fastest layout of a sweep, the fastest direct-mapped one and the
+// study's, each with its hit ratio and modelled cycles per ray.
+std::string best_layout_line(const std::string& scene, const std::vector<Run>& runs, const std::vector<Result>& results,
+                             const std::vector<std::size_t>& group) {
+    const Run& first = runs[group.front()];
+    const bool node = first.sweep == "node";
+    auto layout = [&](std::size_t i) { return node ? runs[i].config.node_cache : runs[i].config.triangle_cache; };
+    auto cycles = [&](std::size_t i) { return results[i].stats.cycles; };
+    const CacheLayout study = node ? study_node_layout(first.structure) : kStudyTriangleLayout;
+    std::size_t best = group.front(), best_direct = group.front(), at_study = group.front();
+    for (std::size_t i : group) {
+        if (cycles(i) < cycles(best)) best = i;
+        if (layout(i).ways == 1 && (layout(best_direct).ways != 1 || cycles(i) < cycles(best_direct))) best_direct = i;
+        if (layout(i) == study) at_study = i;
+    }
+    auto cell = [&](std::size_t i) {
+        const LocalStoreStats& s = results[i].stats;
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%s: %.1f %%, %.0f", layout(i).to_string().c_str(),
+                      100.0 * (node ? s.node_cache : s.triangle_cache).hit_ratio(), s.cycles_per_ray());
+        return std::string(buf);
+    };
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.2f |\n", scene.c_str(),
+                  first.structure.c_str(), first.traversal.c_str(), to_string(first.config.access),
+                  node ? "nodes" : "triangles", cell(best).c_str(), cell(best_direct).c_str(), cell(at_study).c_str(),
+                  static_cast<double>(cycles(at_study)) / static_cast<double>(cycles(best)));
+    return buf;
+}
+
+std::vector<std::string> checked_choices(const std::string& option, const std::vector<std::string>& values,
+                                         const std::vector<std::string>& allowed) {
+    if (values.empty()) throw Error(option + " needs at least one value");
+    for (const std::string& v : values)
+        if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+            std::string list;
+            for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+            throw Error(option + " '" + v + "' is not one of: " + list);
+        }
+    return values;
+}
+
+}  // namespace
+
+Runner add_cache_study(CLI::App& app) {
+    struct Options {
+        std::vector<std::string> scenes;
+        std::string out = "cache-study", size;
+        int packet = RenderOptions{}.packet, sample = 8;
+        unsigned threads = 0;
+        bool overwrite = false;
+        std::vector<std::string> structures{"kd", "bih"}, traversals{"branched", "branchless"},
+            access{"sync", "async"}, sweeps{"node", "triangle"};
+    };
+    auto o = std::make_shared<Options>();
+    auto* cmd = app.add_subcommand("cache-study", "The study's cache experiments (Graphs 5-1 to 5-10) through the "
+                                                  "local-store model: CSV for bench/plot_cache_study.py");
+    cmd->add_option("scenes", o->scenes, scene_help() + "; one or more")->required();
+    cmd->add_option("-o,--out", o->out, "Output folder (cache_study.csv, best_layouts.md)")->capture_default_str();
+    cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default: each view file's)");
+    cmd->add_option("--packet", o->packet, "Packet edge P: P x P primary rays, then their shadow rays")
+        ->capture_default_str();
+    cmd->add_option("--sample", o->sample, "Trace the packets whose column + row is a multiple of N (1: all)")
+        ->capture_default_str();
+    cmd->add_option("--threads", o->threads, "Runs traced at once (0: all cores)")->capture_default_str();
+    cmd->add_option("--structures", o->structures, "Structures: kd, bih")->capture_default_str();
+    cmd->add_option("--traversals", o->traversals, "Traversals: branched, branchless")->capture_default_str();
+    cmd->add_option("--access", o->access, "Cache access modes: sync, async")->capture_default_str();
+    cmd->add_option("--sweeps", o->sweeps, "Caches swept: node (Graphs 5-1..5-6), triangle (5-7..5-10)")
+        ->capture_default_str();
+    cmd->add_flag("--overwrite", o->overwrite, "Replace existing output files");
+    return [o] {
+        checked_choices("--structures", o->structures, {"kd", "bih"});
+        checked_choices("--traversals", o->traversals, {"branched", "branchless"});
+        checked_choices("--access", o->access, {"sync", "async"});
+        checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
+        if (o->sample < 1 || o->sample > 1024)
+            throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
+        if (o->packet < 1 || o->packet > 256)
+            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, 256]");
+        std::error_code ec;
+        std::filesystem::create_directories(o->out, ec);
+        if (!std::filesystem::is_directory(o->out)) throw Error("--out '" + o->out + "': cannot create the folder");
+        const std::string csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
+        const std::string md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
+        for (const std::string& p : {csv_path, md_path})
+            if (!o->overwrite && std::filesystem::exists(p))
+                throw Error(p + ": file exists (pass --overwrite to replace it)");
+        const unsigned threads = o->threads ? o->threads : std::max(1u, std::thread::hardware_concurrency());
+
+        std::string csv = csv_header();
+        std::string md = "| scene | structure | traversal | access | cache | best layout: hit ratio, cycles/ray | best "
+                         "direct-mapped | the study's layout | study / best |\n|---|---|---|---|---|---|---|---|---|\n";
+        Timer total;
+        for (const std::string& spec : o->scenes) {
+            const Scene scene = load_scene(spec);
+            int width = scene.width, height = scene.height;
+            if (!o->size.empty()) std::tie(width, height) = parse_size("--size", o->size);
+            const Workload w = sampled_frame(scene, width, height, o->packet, o->sample);
+            std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): %zu "
+                        "primary + %zu shadow rays of the frame's %llu\n",
+                        scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(), w.frame_packets,
+                        o->packet, o->packet, o->sample, w.primary.size(), w.shadow.size(),
+                        static_cast<unsigned long long>(w.frame_rays));
+            std::fflush(stdout);
+            std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
+            std::vector<Run> runs;
+            for (const std::string& structure : o->structures) {
+                AccelConfig ac;
+                ac.kind = structure;
+                ac.threads = o->threads;
+                bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
+                for (const std::string& sweep : o->sweeps)
+                    for (const std::string& traversal : o->traversals)
+                        for (const std::string& access : o->access)
+                            for (const CacheLayout& layout : swept_layouts()) {
+                                Run run{structure, traversal, sweep, LocalStoreConfig{}};
+                                run.config.access = parse_cache_access("--access", access);
+                                run.config.packet_rays = static_cast<std::size_t>(o->packet) * o->packet;
+                                run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
+                                run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
+                                runs.push_back(run);
+                            }
+            }
+            Timer timer;
+            const std::vector<Result> results = trace_all(bases, runs, w, threads);
+            std::printf("  %zu runs in %.1f s on %u threads\n", runs.size(), timer.seconds(), threads);
+            std::fflush(stdout);
+            std::map<std::string, std::vector<std::size_t>> groups;  // runs of one sweep, in order
+            std::vector<std::string> group_order;
+            for (std::size_t i = 0; i < runs.size(); ++i) {
+                csv += csv_row(scene.name, runs[i], results[i], w.frame_rays);
+                const std::string key = runs[i].structure + runs[i].sweep + runs[i].traversal +
+                                        to_string(runs[i].config.access);
+                if (groups[key].empty()) group_order.push_back(key);
+                groups[key].push_back(i);
+            }
+            for (const std::string& key : group_order) md += best_layout_line(scene.name, runs, results, groups[key]);
+        }
+        write_file_atomically(csv_path, csv, o->overwrite);
+        write_file_atomically(md_path, md, o->overwrite);
+        std::printf("\n%s\nwrote %s and %s in %.1f s; draw the graphs with:\n"
+                    "  python3 bench/plot_cache_study.py %s %s\n",
+                    md.c_str(), csv_path.c_str(), md_path.c_str(), total.seconds(), csv_path.c_str(), o->out.c_str());
+        return 0;
+    };
+}
+
+}  // namespace cellrt::cli

@@ -1,0 +1,15 @@
+// Output files are written whole or not at all, and replace nothing the user has unless asked.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace cellrt {
+
+// Writes `bytes` beside `path` under a temporary name and renames it into place, so an interrupted
+// write never leaves a partial file under `path`. Refuses to replace an existing file unless
+// `overwrite`. Throws cellrt::Error naming the path on any failure (missing directory, no permission,
+// disk full).
+void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite);
+
+}  // namespace cellrt

@@ -1,0 +1,263 @@
+// The kd-tree and the BIH traced through the local-store model: the structure is built as for direct
+// memory, its arrays are mapped into the model's main memory, and every worker thread runs the
+// structure's own kernels (kd_traversal.hpp, bih_traversal.hpp) over CachedMemory and its own
+// local store, packet by packet.
+#include <algorithm>
+#include <type_traits>
+#include <utility>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "accel/traversal.hpp"
+#include "bih/bih_accel.hpp"
+#include "cached_memory.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/timer.hpp"
+#include "kdtree/kd_accel.hpp"
+#include "local_store.hpp"
+
+namespace cellrt {
+namespace detail {
+namespace {
+
+// What the model needs of a structure: its kernels and their stacks, and its arrays.
+struct KdStructure {
+    using Node = KdNode;
+    using Traversal = KdTraversal;
+    static constexpr const char* kName = "kd";
+
+    // The same traversals and parameters as for direct memory (kd_accel.hpp).
+    static const std::vector<std::string>& traversal_names() { return kd_traversal_names(); }
+    static Traversal traversal(const std::string& name) { return kd_traversal(name); }
+    static bool branchless(Traversal t) { return t == KdTraversal::branchless; }
+    // The kernels' stacks as they declare them: TA_rec's points on the ray (two t, two points, a node
+    // and a link: 40 bytes), the others' (node, tmin, tmax) entries.
+    static std::size_t stack_bytes(Traversal t) {
+        return t == KdTraversal::rec ? (kKdMaxDepth + 3) * 40 : (kKdMaxDepth + 2) * 12;
+    }
+    template <class Fn>
+    static void with_kernel(Traversal t, Fn&& fn) {
+        with_kd_kernel(t, std::forward<Fn>(fn));
+    }
+
+    KdStructure(std::span<const Triangle> tris, const AccelConfig& config)
+        : params(read_kd_params(config)), triangles(tris), tree(build_kdtree(tris, params)) {}
+    std::span<const KdNode> nodes() const { return tree.nodes; }
+    std::span<const std::uint32_t> entries() const { return tree.indices; }
+    std::span<const Triangle> triangle_array() const { return triangles; }
+    std::uint64_t leaf_bound() const { return tree.indices.size(); }
+    const Box3& bounds() const { return tree.bounds; }
+    std::vector<std::pair<std::string, std::string>> report() const { return kd_report(tree, params); }
+    std::size_t memory_bytes() const { return nodes().size_bytes() + entries().size_bytes(); }
+
+    KdBuildParams params;
+    std::span<const Triangle> triangles;
+    KdTree tree;
+};
+
+struct BihStructure {
+    using Node = BihNode;
+    using Traversal = BihTraversal;
+    static constexpr const char* kName = "bih";
+
+    static const std::vector<std::string>& traversal_names() { return bih_traversal_names(); }
+    static Traversal traversal(const std::string& name) { return bih_traversal(name); }
+    static bool branchless(Traversal t) { return t == BihTraversal::branchless; }
+    static std::size_t stack_bytes(Traversal) { return (kBihMaxDepth + 3) * 12; }
+    template <class Fn>
+    static void with_kernel(Traversal t, Fn&& fn) {
+        with_bih_kernel(t, std::forward<Fn>(fn));
+    }
+
+    BihStructure(std::span<const Triangle> tris, const AccelConfig& config)
+        : params(read_bih_params(config)), tree(build_bih(tris, params)) {}
+    std::span<const BihNode> nodes() const { return tree.nodes; }
+    std::span<const std::uint32_t> entries() const { return tree.prims; }
+    std::span<const Triangle> triangle_array() const { return tree.triangles; }
+    std::uint64_t leaf_bound() const { return tree.triangles.size(); }
+    const Box3& bounds() const { return tree.bounds; }
+    std::vector<std::pair<std::string, std::string>> report() const { return bih_report(tree, params); }
+    std::size_t memory_bytes() const {
+        return nodes().size_bytes() + entries().size_bytes() + triangle_array().size_bytes();
+    }
+
+    BihBuildParams params;
+    BihTree tree;
+};
+
+// A built structure and its image in the model's main memory, shared by every configuration traced over it.
+template <class S>
+struct Built {
+    Built(std::span<const Triangle> triangles, const AccelConfig& config) : structure(build(triangles, config)) {
+        image.nodes = memory.add(structure.nodes().data(), structure.nodes().size_bytes());
+        image.entries = memory.add(structure.entries().data(), structure.entries().size_bytes());
+        image.triangles = memory.add(structure.triangle_array().data(), structure.triangle_array().size_bytes());
+        image.node_count = static_cast<std::uint32_t>(structure.nodes().size());
+        image.leaf_bound = structure.leaf_bound();
+        image.depth = node_depths(structure.nodes());
+        for (std::size_t i = 0; i < image.node_count; ++i)
+            if (image.depth[i] != image.kNoDepth && structure.nodes()[i].is_leaf())
+                image.max_leaf = std::max(image.max_leaf, structure.nodes()[i].count());
+    }
+    S build(std::span<const Triangle> triangles, const AccelConfig& config) {
+        Timer timer;
+        S s(triangles, config);
+        build_seconds = timer.seconds();
+        return s;
+    }
+    double build_seconds = 0.0;
+    S structure;
+    MainMemory memory;
+    StructureImage<typename S::Node> image;
+};
+
+// The kernels' work counters, forwarded, and the cycles of that work on the worker's clock.
+template <class Counters>
+struct ModelCounters {
+    Counters& counters;
+    WorkerStore& store;
+    std::uint32_t step_cycles, leaf_cycles, test_cycles;
+
+    void node() {
+        counters.node();
+        store.work(step_cycles);
+    }
+    void leaf() {
+        counters.leaf();
+        store.work(leaf_cycles);
+    }
+    void triangle() {
+        counters.triangle();
+        store.work(test_cycles);
+    }
+};
+
+std::string validated_traversal(const char* structure, const std::vector<std::string>& names,
+                                const std::string& traversal) {
+    AccelConfig c;
+    c.traversal = traversal;
+    return traversal_or_default(c, names, structure);
+}
+
+template <class S>
+class ModelAccelerator final : public LocalStoreAccelerator {
+public:
+    using Node = typename S::Node;
+
+    ModelAccelerator(std::shared_ptr<const Built<S>> built, const LocalStoreConfig& config,
+                     const std::string& traversal)
+        : built_(std::move(built)),
+          config_(config),
+          traversal_name_(validated_traversal(S::kName, S::traversal_names(), traversal)),
+          traversal_(S::traversal(traversal_name_)),
+          allocations_(allocate_local_store(config, S::stack_bytes(traversal_))),
+          workers_([this] { return WorkerStore(config_, built_->memory); }) {}
+
+    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        trace(rays.size(), sizeof(Hit), [&](std::size_t i, std::size_t n, auto& kernel) {
+            closest_hits(built_->structure.bounds(), rays.subspan(i, n), hits.subspan(i, n), counters, kernel);
+        });
+    }
+
+    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                  TraversalCounters* counters) const override {
+        trace(rays.size(), sizeof(std::uint8_t), [&](std::size_t i, std::size_t n, auto& kernel) {
+            any_hits(built_->structure.bounds(), rays.subspan(i, n), occluded.subspan(i, n), counters, kernel);
+        });
+    }
+
+    AccelStats stats() const override {
+        const LocalStoreConfig& c = config_;
+        AccelStats s{S::kName, built_->build_seconds, built_->structure.memory_bytes(),
+                     {{"traversal", traversal_name_},
+                      {"local store", std::to_string(c.budget_bytes / 1024) + " KiB, node cache " +
+                                          c.node_cache.to_string() + ", triangle cache " +
+                                          c.triangle_cache.to_string() + ", " + to_string(c.access) +
+                                          (c.access == CacheAccess::async && !c.retouch ? " without re-touch" : "")}}};
+        for (auto& f : built_->structure.report()) s.figures.push_back(std::move(f));
+        return s;
+    }
+
+    const LocalStoreConfig& local_store_config() const override { return config_; }
+    std::vector<LocalStoreAllocation> local_store_allocations() const override { return allocations_; }
+
+    LocalStoreStats local_store_stats() const override {
+        LocalStoreStats s;
+        for (const WorkerStore& w : workers_) {
+            s.node_cache += w.node_cache.stats;
+            s.triangle_cache += w.triangle_cache.stats;
+            s.rays += w.rays();
+            s.packets += w.packets();
+            s.cycles += w.cycles();
+            s.stall_cycles += w.stall_cycles();
+            s.frame_cycles = std::max(s.frame_cycles, w.cycles());
+            ++s.workers;
+        }
+        return s;
+    }
+
+    std::unique_ptr<LocalStoreAccelerator> with_local_store(const LocalStoreConfig& config,
+                                                            const std::string& traversal) const override {
+        return std::make_unique<ModelAccelerator>(built_, config, traversal);
+    }
+
+private:
+    // Traces `count` rays on the calling thread's worker, one packet of the local store at a time:
+    // `batch(first, n, kernel)` runs the batch loop over rays [first, first + n) with `kernel`.
+    template <class Batch>
+    void trace(std::size_t count, std::size_t result_bytes, Batch&& batch) const {
+        WorkerStore& store = workers_.local();
+        CachedMemory<Node> mem(store, built_->image, config_);
+        const CostModel& cost = config_.cost;
+        const std::uint32_t step = cost.inner_step(S::branchless(traversal_));
+        S::with_kernel(traversal_, [&](auto kernel) {
+            auto through_model = [&](const TraversalRay& r, auto& q, auto& c) {
+                store.begin_ray();
+                ModelCounters<std::remove_reference_t<decltype(c)>> counted{c, store, step, cost.leaf,
+                                                                            cost.triangle_test};
+                return kernel(built_->structure.tree, mem, r, q, counted);
+            };
+            for (std::size_t i = 0; i < count; i += config_.packet_rays) {
+                const std::size_t n = std::min(config_.packet_rays, count - i);
+                store.load_packet(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(n * sizeof(Ray)));
+                batch(i, n, through_model);
+                store.store_results(static_cast<std::uint32_t>(n * result_bytes));
+            }
+        });
+    }
+
+    std::shared_ptr<const Built<S>> built_;
+    LocalStoreConfig config_;
+    std::string traversal_name_;
+    typename S::Traversal traversal_;
+    std::vector<LocalStoreAllocation> allocations_;
+    mutable tbb::enumerable_thread_specific<WorkerStore> workers_;
+};
+
+template <class S>
+std::unique_ptr<LocalStoreAccelerator> make_model(std::span<const Triangle> triangles, const AccelConfig& config,
+                                                  const LocalStoreConfig& local_store) {
+    // Refuse a bad traversal or configuration before spending time on the build.
+    const std::string traversal = validated_traversal(S::kName, S::traversal_names(), config.traversal);
+    allocate_local_store(local_store, S::stack_bytes(S::traversal(traversal)));
+    auto built = std::make_shared<const Built<S>>(triangles, config);
+    return std::make_unique<ModelAccelerator<S>>(std::move(built), local_store, traversal);
+}
+
+}  // namespace
+}  // namespace detail
+
+std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
+                                                                    const AccelConfig& config,
+                                                                    const LocalStoreConfig& local_store) {
+    if (config.kind != "kd" && config.kind != "bih")
+        throw Error("the local-store model runs the kd-tree and the BIH (--accel kd or bih), not '" + config.kind +
+                    "'");
+    if (config.simd != "off")
+        throw Error("the local-store model runs the single-ray kernels, not SIMD packets (simd '" + config.simd +
+                    "'; use off)");
+    if (config.kind == "kd") return detail::make_model<detail::KdStructure>(triangles, config, local_store);
+    return detail::make_model<detail::BihStructure>(triangles, config, local_store);
+}
+
+}  // namespace cellrt
