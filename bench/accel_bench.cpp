@@ -59,8 +59,6 @@ FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
     return f;
 }
 
-// KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. kd:branched, bih+avx2 (SIMD packets),
-// embree:packet16, kd+avx512@max_depth=20,leaf_size=2 (build parameters).
 // Incoherent rays, for the packet kernels' worst case: origins uniform in the scene's box,
 // directions uniform on the sphere; the same rays (with tfar a third of the box's diagonal) serve as
 // "shadow" rays. Deterministic (SplitMix64).
@@ -85,29 +83,6 @@ FrameRays random_rays(const Scene& scene, std::size_t n) {
         f.shadow.push_back(r);
     }
     return f;
-}
-
-AccelConfig parse_config(std::string text, unsigned threads) {
-    AccelConfig c;
-    if (const auto at = text.find('@'); at != std::string::npos) {
-        std::string params = text.substr(at + 1) + ",";
-        text = text.substr(0, at);
-        for (std::size_t b = 0, e; (e = params.find(',', b)) != std::string::npos; b = e + 1) {
-            const std::string kv = params.substr(b, e - b);
-            const auto eq = kv.find('=');
-            if (eq == std::string::npos) throw Error("build parameter '" + kv + "' must be NAME=VALUE");
-            c.params[kv.substr(0, eq)] = kv.substr(eq + 1);
-        }
-    }
-    if (const auto plus = text.find('+'); plus != std::string::npos) {
-        c.simd = text.substr(plus + 1);
-        text = text.substr(0, plus);
-    }
-    const auto colon = text.find(':');
-    c.kind = text.substr(0, colon);
-    if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
-    c.threads = threads;
-    return c;
 }
 
 struct Result {
@@ -187,7 +162,8 @@ int main(int argc, char** argv) {
                         scene.triangles.size(), w, h, rays.primary.size(), rays.shadow.size());
             std::vector<Result> results;
             for (const std::string& text : configs) {
-                const AccelConfig cfg = parse_config(text, threads);
+                AccelConfig cfg = parse_accel_config(text);
+                cfg.threads = threads;
                 const auto kinds = accelerator_kinds();
                 if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
                     std::fprintf(stderr, "skipping %s: not built into this binary\n", text.c_str());

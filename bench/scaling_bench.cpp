@@ -29,19 +29,6 @@ double median(std::vector<double> v) {
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-// KIND[:TRAVERSAL][+SIMD], as cellrt_bench takes them.
-AccelConfig parse_config(std::string text) {
-    AccelConfig c;
-    if (const auto plus = text.find('+'); plus != std::string::npos) {
-        c.simd = text.substr(plus + 1);
-        text = text.substr(0, plus);
-    }
-    const auto colon = text.find(':');
-    c.kind = text.substr(0, colon);
-    if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
-    return c;
-}
-
 struct Point {
     std::string scene, config, dispatch;
     int packet;
@@ -81,7 +68,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> scene_names;
     std::string yardstick;
     for (const std::string& c : configs)
-        if (yardstick.empty() && parse_config(c).kind == "embree") yardstick = c;
+        if (yardstick.empty() && parse_accel_config(c).kind == "embree") yardstick = c;
     try {
         for (const std::string& name : scenes) {
             std::string spec = name;
@@ -95,7 +82,7 @@ int main(int argc, char** argv) {
             const Scene scene = load_scene(spec);
             scene_names.push_back(scene.name);
             for (const std::string& cfg_text : configs) {
-                const AccelConfig cfg = parse_config(cfg_text);
+                const AccelConfig cfg = parse_accel_config(cfg_text);
                 const auto kinds = accelerator_kinds();
                 if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
                     std::fprintf(stderr, "skipping %s: not built into this binary\n", cfg.kind.c_str());

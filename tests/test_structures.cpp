@@ -23,18 +23,6 @@ std::vector<std::string> exact_configs() {
 }
 const std::vector<std::string> kConfigs = exact_configs();
 
-AccelConfig parse(std::string text) {
-    AccelConfig c;
-    if (const auto plus = text.find('+'); plus != std::string::npos) {
-        c.simd = text.substr(plus + 1);
-        text = text.substr(0, plus);
-    }
-    const auto colon = text.find(':');
-    c.kind = text.substr(0, colon);
-    if (colon != std::string::npos) c.traversal = text.substr(colon + 1);
-    return c;
-}
-
 std::string name_of(const std::string& config) {
     std::string s = config;
     std::replace(s.begin(), s.end(), ':', '_');
@@ -49,7 +37,7 @@ TEST_P(AgainstBruteForce, SameHits) {
     const Scene* scene = test::structure_scene(scene_name);
     if (!scene) GTEST_SKIP() << "scene " << scene_name << " not found under " << test::scenes_dir();
     const test::ReferenceAnswers& ref = test::cached_reference(scene_name, scene->triangles);
-    const auto accel = make_accelerator(scene->triangles, parse(config));
+    const auto accel = make_accelerator(scene->triangles, parse_accel_config(config));
     test::expect_matches(*accel, ref, config + " on " + scene_name);
 }
 
@@ -64,7 +52,7 @@ class DegenerateInputs : public testing::TestWithParam<std::string> {};
 TEST_P(DegenerateInputs, SameHits) {
     for (const auto& [name, tris] : test::degenerate_scenes()) {
         const test::ReferenceAnswers ref = test::reference_suite(tris, test::small_suite());
-        test::expect_matches(*make_accelerator(tris, parse(GetParam())), ref, GetParam() + " on " + name);
+        test::expect_matches(*make_accelerator(tris, parse_accel_config(GetParam())), ref, GetParam() + " on " + name);
     }
 }
 
@@ -95,7 +83,7 @@ TEST_P(CoherentPackets, SameHits) {
             rays.push_back(shadow_ray(sp.position, sp.normal, scene->light.position));
         }
     ref = test::compute_reference(scene->triangles, rays);
-    const auto accel = make_accelerator(scene->triangles, parse(config));
+    const auto accel = make_accelerator(scene->triangles, parse_accel_config(config));
     for (std::size_t batch : {64u, 256u, 37u}) {
         std::vector<Hit> hits(rays.size());
         std::vector<std::uint8_t> occluded(rays.size());

@@ -68,6 +68,11 @@ public:
 // Throws cellrt::Error for an unknown kind, traversal or parameter, or a parameter out of range.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
 
+// An accelerator configuration written as one string, as the benchmarks and tests name them:
+// KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd:rec", "bih+avx2", "kd+auto@leaf_size=2,bins=64".
+// Throws cellrt::Error for a malformed parameter; the parts themselves are checked by make_accelerator.
+AccelConfig parse_accel_config(std::string spec);
+
 // Kinds built into this binary ("brute", "kd", "bih", and "embree" where Embree 3 was found).
 std::vector<std::string> accelerator_kinds();
 

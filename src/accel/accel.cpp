@@ -54,6 +54,31 @@ std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangle
     throw Error("unknown accelerator '" + config.kind + "' (choose one of: " + join(accelerator_kinds()) + ")");
 }
 
+AccelConfig parse_accel_config(std::string spec) {
+    AccelConfig c;
+    if (const auto at = spec.find('@'); at != std::string::npos) {
+        const std::string params = spec.substr(at + 1);
+        spec.resize(at);
+        for (std::size_t b = 0; b <= params.size();) {
+            const std::size_t e = std::min(params.find(',', b), params.size());
+            const std::string kv = params.substr(b, e - b);
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos || eq == 0)
+                throw Error("accelerator parameter '" + kv + "' must have the form NAME=VALUE");
+            c.params[kv.substr(0, eq)] = kv.substr(eq + 1);
+            b = e + 1;
+        }
+    }
+    if (const auto plus = spec.find('+'); plus != std::string::npos) {
+        c.simd = spec.substr(plus + 1);
+        spec.resize(plus);
+    }
+    const auto colon = spec.find(':');
+    c.kind = spec.substr(0, colon);
+    if (colon != std::string::npos) c.traversal = spec.substr(colon + 1);
+    return c;
+}
+
 std::string traversal_or_default(const AccelConfig& config, const std::vector<std::string>& choices,
                                  const std::string& structure) {
     if (config.traversal.empty()) return choices.front();

@@ -132,37 +132,41 @@ struct DirectMemory {
     const Triangle& triangle(std::uint32_t i) const { return triangles[i]; }
 };
 
-// The batch loops behind Accelerator::intersect/occluded: one branch on the counters per batch, then
-// `kernel(ray, query, counters)` for every valid ray. Invalid rays (ray.hpp) hit nothing.
+// Runs `fn(counters)` with WorkCounters adding to `*sum`, or with NoCounters when `sum` is null: the
+// one branch on counting, per batch.
+template <class Fn>
+void with_counters(TraversalCounters* sum, std::size_t rays, Fn&& fn) {
+    if (sum) {
+        WorkCounters count{*sum};
+        fn(count);
+        sum->rays += rays;
+    } else {
+        NoCounters count;
+        fn(count);
+    }
+}
+
+// The batch loops behind Accelerator::intersect/occluded: `kernel(ray, query, counters)` for every
+// valid ray. Invalid rays (ray.hpp) hit nothing.
 template <class Kernel>
 void closest_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters,
                   Kernel&& kernel) {
-    auto loop = [&](auto& count) {
+    with_counters(counters, rays.size(), [&](auto& count) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
-            if (!is_valid(rays[i])) {
-                hits[i] = Hit{};
-                continue;
-            }
+            hits[i] = Hit{};
+            if (!is_valid(rays[i])) continue;
             const TraversalRay r(rays[i], scene_box);
             ClosestHit q(r);
             kernel(r, q, count);
             hits[i] = q.result();
         }
-    };
-    if (counters) {
-        WorkCounters count{*counters};
-        loop(count);
-        counters->rays += rays.size();
-    } else {
-        NoCounters count;
-        loop(count);
-    }
+    });
 }
 
 template <class Kernel>
 void any_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
               TraversalCounters* counters, Kernel&& kernel) {
-    auto loop = [&](auto& count) {
+    with_counters(counters, rays.size(), [&](auto& count) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             occluded[i] = 0;
             if (!is_valid(rays[i])) continue;
@@ -170,15 +174,7 @@ void any_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<std::u
             AnyHit q(r);
             occluded[i] = kernel(r, q, count) ? 1 : 0;
         }
-    };
-    if (counters) {
-        WorkCounters count{*counters};
-        loop(count);
-        counters->rays += rays.size();
-    } else {
-        NoCounters count;
-        loop(count);
-    }
+    });
 }
 
 }  // namespace cellrt::detail
