@@ -1,6 +1,7 @@
 // The study's scaling measurement (its Tables 5-1 and 5-2), with Embree alongside: seconds per frame
 // (512 x 512, primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode
-// and packet size. Every point is a warm-up frame and the median of --repeats frames; every table
+// and packet size. Every point is a warm-up frame and the median of --repeats frames, the worker
+// counts interleaved frame by frame; every table
 // shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
 // and packet size, measured in the same run. Writes Markdown tables to stdout and every point as
 // JSON and CSV; bench/plot_scaling.py draws the curves.
@@ -90,24 +91,31 @@ int main(int argc, char** argv) {
                 }
                 const auto accel = make_accelerator(scene.triangles, cfg);
                 for (const std::string& d : dispatches)
-                    for (int p : packets)
-                        for (unsigned w : workers) {
+                    for (int p : packets) {
+                        // Worker counts are interleaved frame by frame, so that a machine whose speed
+                        // drifts (shared hosts do) shifts every count alike and efficiencies hold.
+                        auto options = [&](unsigned w) {
                             RenderOptions o;
                             o.width = o.height = size;
                             o.threads = w;
                             o.packet = p;
                             o.dispatch = parse_dispatch(d);
-                            render(scene, *accel, o);  // warm-up
-                            std::vector<double> times;
-                            RenderStats st;
-                            for (int r = 0; r < repeats; ++r) {
-                                render(scene, *accel, o, &st);
-                                times.push_back(st.seconds);
+                            return o;
+                        };
+                        for (unsigned w : workers) render(scene, *accel, options(w));  // warm-up
+                        std::map<unsigned, std::vector<double>> times;
+                        RenderStats st;
+                        for (int r = 0; r < repeats; ++r)
+                            for (unsigned w : workers) {
+                                render(scene, *accel, options(w), &st);
+                                times[w].push_back(st.seconds);
                             }
-                            points.push_back({scene.name, cfg_text, d, p, w, median(times), st.primary_rays + st.shadow_rays});
-                            std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(), cfg_text.c_str(),
-                                         d.c_str(), p, p, w, points.back().seconds);
+                        for (unsigned w : workers) {
+                            points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), st.primary_rays + st.shadow_rays});
+                            std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
+                                         cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
                         }
+                    }
             }
         }
     } catch (const Error& e) {

@@ -26,6 +26,7 @@ struct PacketWork {
     std::vector<Vec3> normals;
     std::vector<std::uint32_t> shadow_pixel;
     std::vector<std::uint32_t> order;  // order[i]: the pixel (offset in the packet) of ray i
+    int order_width = 0, order_height = 0;  // the packet shape `order` was made for
     TraversalCounters primary, shadow;
     std::uint64_t shadow_ray_count = 0;
 };
@@ -33,7 +34,11 @@ struct PacketWork {
 // Primary rays of the packet, one batch; then one shadow ray per hit, one batch; then shading.
 void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCamera& camera, const PixelRect& rect,
                   bool count, PacketWork& w, std::span<Vec3> colours) {
-    packet_order(rect, w.order);
+    if (rect.width() != w.order_width || rect.height() != w.order_height) {  // only edge packets differ
+        packet_order(rect, w.order);
+        w.order_width = rect.width();
+        w.order_height = rect.height();
+    }
     w.rays.clear();
     for (const std::uint32_t p : w.order)
         w.rays.push_back(camera.primary(rect.x0 + static_cast<int>(p) % rect.width(), rect.y0 + static_cast<int>(p) / rect.width()));
