@@ -102,12 +102,13 @@ int main(int argc, char** argv) {
                             o.dispatch = parse_dispatch(d);
                             return o;
                         };
-                        for (unsigned w : workers) render(scene, *accel, options(w));  // warm-up
+                        Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
+                        for (unsigned w : workers) render(scene, *accel, options(w), frame);  // warm-up
                         std::map<unsigned, std::vector<double>> times;
                         RenderStats st;
                         for (int r = 0; r < repeats; ++r)
                             for (unsigned w : workers) {
-                                render(scene, *accel, options(w), &st);
+                                render(scene, *accel, options(w), frame, &st);
                                 times[w].push_back(st.seconds);
                             }
                         for (unsigned w : workers) {

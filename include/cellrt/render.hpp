@@ -36,6 +36,11 @@ struct RenderStats {
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,
              RenderStats* stats = nullptr);
 
+// The same into `frame`, reusing its pixels when it already has the size (a renderer drawing frame
+// after frame keeps its frame buffer; a fresh 512 x 512 buffer costs hundreds of page faults).
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
+            RenderStats* stats = nullptr);
+
 // The point a hit names and the triangle's geometric normal there, turned to face the side the ray
 // came from.
 struct SurfacePoint {

@@ -29,6 +29,16 @@ struct PacketWork {
     int order_width = 0, order_height = 0;  // the packet shape `order` was made for
     TraversalCounters primary, shadow;
     std::uint64_t shadow_ray_count = 0;
+
+    void reserve(std::size_t n) {
+        rays.reserve(n);
+        shadow_rays.reserve(n);
+        hits.reserve(n);
+        occluded.reserve(n);
+        normals.reserve(n);
+        shadow_pixel.reserve(n);
+        order.reserve(n);
+    }
 };
 
 // Primary rays of the packet, one batch; then one shadow ray per hit, one batch; then shading.
@@ -103,9 +113,16 @@ Ray shadow_ray(const Vec3& p, const Vec3& n, const Vec3& light) {
 }
 
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, RenderStats* stats) {
+    Image image;
+    render(scene, accel, options, image, stats);
+    return image;
+}
+
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& image,
+            RenderStats* stats) {
     const PinholeCamera camera(scene.camera, options.width, options.height);
     const PacketGrid grid(options.width, options.height, options.packet);
-    Image image(options.width, options.height);
+    if (image.width != options.width || image.height != options.height) image = Image(options.width, options.height);
     ScheduleOptions schedule;
     schedule.dispatch = options.dispatch;
     schedule.workers = options.threads;
@@ -113,6 +130,10 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
     schedule.cancel = options.cancel;
     schedule.progress = options.progress;
     std::vector<PacketWork> work(worker_count(schedule));
+    // Sized here, so that workers never allocate: a thread's first allocation would create a malloc
+    // arena of its own (page faults on every frame), and the hot path must not allocate.
+    const auto packet_rays = static_cast<std::size_t>(options.packet) * static_cast<std::size_t>(options.packet);
+    for (PacketWork& w : work) w.reserve(packet_rays);
 
     Timer timer;
     const bool complete = run_packets(grid, schedule, image, [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
@@ -129,7 +150,6 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
             stats->shadow_rays += w.shadow_ray_count;
         }
     }
-    return image;
 }
 
 }  // namespace cellrt

@@ -36,8 +36,10 @@ bool cancelled(const ScheduleOptions& o) { return o.cancel && o.cancel->load(std
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
               unsigned workers) {
     std::atomic<std::size_t> next{0}, done{0};
+    // Allocated here: a worker that allocates gets a malloc arena of its own, on every frame.
+    std::vector<std::vector<Vec3>> buffers(workers, std::vector<Vec3>(static_cast<std::size_t>(grid.packet) * grid.packet));
     auto work = [&](unsigned w) {
-        std::vector<Vec3> colours(static_cast<std::size_t>(grid.packet) * grid.packet);
+        std::vector<Vec3>& colours = buffers[w];
         for (std::size_t p = next.fetch_add(1, std::memory_order_relaxed); p < grid.count();
              p = next.fetch_add(1, std::memory_order_relaxed)) {
             if (cancelled(options)) return;
