@@ -116,6 +116,27 @@ struct AnyHit {
     }
 };
 
+// A cell waiting on the stack of the stack-based traversals.
+struct StackEntry {
+    std::uint32_t node;
+    float tmin, tmax;
+};
+
+// Pops the next stacked cell that can still hold the answer, skipping those that start past the
+// query's cull distance; false when no entry above `bottom` is left. `sp` ends on the popped slot.
+template <class Query>
+bool pop_live(const StackEntry* stack, int& sp, int bottom, const Query& q, std::uint32_t& node, float& tmin,
+              float& tmax) {
+    do {
+        if (sp == bottom) return false;
+        --sp;
+    } while (stack[sp].tmin > q.cull_t());
+    node = stack[sp].node;
+    tmin = stack[sp].tmin;
+    tmax = stack[sp].tmax;
+    return true;
+}
+
 // Direct memory access: the kernels read nodes, leaf indices and triangles through a memory policy so
 // that the local-store model can run the very same kernels. References returned by a policy are valid
 // until its next access; kernels copy nodes. touch_node() announces a node that will be read later

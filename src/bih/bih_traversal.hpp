@@ -27,13 +27,9 @@ bool bih_leaf(const BihNode& leaf, Memory& mem, const TraversalRay& r, Query& q,
 
 template <class Query, class Memory, class Counters>
 bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    struct Entry {
-        std::uint32_t node;
-        float tmin, tmax;
-    };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
-    Entry stack[kBihMaxDepth + 1];
+    StackEntry stack[kBihMaxDepth + 1];
     int sp = 0;
     std::uint32_t index = 0;
     for (;;) {
@@ -61,13 +57,7 @@ bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay&
             n = mem.node(index);
         }
         if (reached_leaf && bih_leaf(n, mem, r, q, c)) return true;
-        do {
-            if (sp == 0) return false;
-            --sp;
-        } while (stack[sp].tmin > q.cull_t());
-        index = stack[sp].node;
-        tmin = stack[sp].tmin;
-        tmax = stack[sp].tmax;
+        if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
     }
 }
 
@@ -76,14 +66,10 @@ bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay&
 // a sentinel naming node 1, the empty padding leaf, which ends the traversal.
 template <class Query, class Memory, class Counters>
 bool bih_traverse_branchless(const BihTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    struct Entry {
-        std::uint32_t node;
-        float tmin, tmax;
-    };
     constexpr std::uint32_t kSentinel = 1;
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
-    Entry stack[kBihMaxDepth + 3];
+    StackEntry stack[kBihMaxDepth + 3];
     stack[0] = {kSentinel, tmin, tmax};
     int sp = 1;
     std::uint32_t index = 0;
@@ -109,13 +95,7 @@ bool bih_traverse_branchless(const BihTree& tree, Memory& mem, const TraversalRa
         }
         if (index == kSentinel) return false;
         if (bih_leaf(n, mem, r, q, c)) return true;
-        do {
-            --sp;
-        } while (sp > 0 && stack[sp].tmin > q.cull_t());
-        if (sp == 0) return false;
-        index = stack[sp].node;
-        tmin = stack[sp].tmin;
-        tmax = stack[sp].tmax;
+        if (!pop_live(stack, sp, 1, q, index, tmin, tmax)) return false;  // entry 0 is the sentinel
     }
 }
 

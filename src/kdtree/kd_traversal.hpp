@@ -48,14 +48,10 @@ bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, C
 // the side the direction points from, the far one is pushed when the ray reaches it.
 template <class Query, class Memory, class Counters>
 bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    struct Entry {
-        std::uint32_t node;
-        float tmin, tmax;
-    };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     Mailbox tested;
-    Entry stack[kKdMaxDepth + 1];
+    StackEntry stack[kKdMaxDepth + 1];
     int sp = 0;
     std::uint32_t index = 0;
     for (;;) {
@@ -79,13 +75,7 @@ bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r
             n = mem.node(index);
         }
         if (kd_leaf(n, mem, r, q, c, tested)) return true;
-        do {
-            if (sp == 0) return false;
-            --sp;
-        } while (stack[sp].tmin > q.cull_t());
-        index = stack[sp].node;
-        tmin = stack[sp].tmin;
-        tmax = stack[sp].tmax;
+        if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
     }
 }
 
@@ -94,14 +84,10 @@ bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r
 // is then popped from the top. The only branch left in the inner loop is the loop's own.
 template <class Query, class Memory, class Counters>
 bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    struct Entry {
-        std::uint32_t node;
-        float tmin, tmax;
-    };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     Mailbox tested;
-    Entry stack[kKdMaxDepth + 2];
+    StackEntry stack[kKdMaxDepth + 2];
     int sp = 0;
     std::uint32_t index = 0;
     for (;;) {
@@ -124,13 +110,7 @@ bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay&
             n = mem.node(index);
         }
         if (kd_leaf(n, mem, r, q, c, tested)) return true;
-        do {
-            if (sp == 0) return false;
-            --sp;
-        } while (stack[sp].tmin > q.cull_t());
-        index = stack[sp].node;
-        tmin = stack[sp].tmin;
-        tmax = stack[sp].tmax;
+        if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
     }
 }
 
