@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""Draws the scaling curves of cellrt_scaling's JSON: seconds per frame and parallel efficiency
-against workers, one figure per scene, one line per structure, dispatch mode and packet size.
+"""Draws the scaling curves of cellrt_scaling's JSON: per scene, seconds per frame and parallel
+efficiency against workers, one row per dispatch mode; colour = structure, line style = packet size.
 
-usage: bench/plot_scaling.py scaling.json OUTDIR
+usage: bench/plot_scaling.py scaling.json OUTDIR     (Debian's python3, with python3-matplotlib)
 """
 import json
 import os
@@ -14,6 +14,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+STYLES = ["-", "--", ":", "-."]
+
 
 def main() -> int:
     if len(sys.argv) != 3:
@@ -22,25 +24,38 @@ def main() -> int:
     with open(sys.argv[1], encoding="utf-8") as f:
         points = json.load(f)
     os.makedirs(sys.argv[2], exist_ok=True)
-    by_scene = defaultdict(lambda: defaultdict(list))
+    # scene -> dispatch -> (config, packet) -> [(workers, seconds)]
+    data = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))
     for p in points:
-        key = f'{p["config"]} {p["dispatch"]} {p["packet"]}x{p["packet"]}'
-        by_scene[p["scene"]][key].append((p["workers"], p["seconds"]))
-    for scene, lines in by_scene.items():
-        fig, (ax_t, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
-        for key, pts in sorted(lines.items()):
-            pts.sort()
-            w = [x for x, _ in pts]
-            t = [y for _, y in pts]
-            base = t[0] * w[0]
-            ax_t.plot(w, t, marker="o", label=key)
-            ax_e.plot(w, [base / (ti * wi) for wi, ti in pts], marker="o", label=key)
-        ax_t.set(xlabel="workers", ylabel="seconds per frame", title=f"{scene}: time", yscale="log")
-        ax_e.set(xlabel="workers", ylabel="parallel efficiency", title=f"{scene}: efficiency", ylim=(0, 1.1))
-        ax_e.legend(fontsize=7)
-        fig.tight_layout()
+        data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append((p["workers"], p["seconds"]))
+    for scene, by_dispatch in data.items():
+        dispatches = sorted(by_dispatch)
+        configs = sorted({c for d in by_dispatch.values() for c, _ in d})
+        packets = sorted({p for d in by_dispatch.values() for _, p in d})
+        colour = {c: f"C{i}" for i, c in enumerate(configs)}
+        style = {p: STYLES[i % len(STYLES)] for i, p in enumerate(packets)}
+        fig, axes = plt.subplots(len(dispatches), 2, figsize=(11, 3.6 * len(dispatches)), squeeze=False)
+        for row, d in enumerate(dispatches):
+            ax_t, ax_e = axes[row]
+            for (config, packet), pts in sorted(by_dispatch[d].items()):
+                pts.sort()
+                w = [x for x, _ in pts]
+                t = [y for _, y in pts]
+                label = f"{config} {packet}x{packet}"
+                kw = dict(color=colour[config], linestyle=style[packet], marker="o", label=label)
+                ax_t.plot(w, t, **kw)
+                ax_e.plot(w, [t[0] * w[0] / (ti * wi) for wi, ti in pts], **kw)
+            ax_t.set(xlabel="workers", ylabel="seconds per frame", title=f"{scene}, {d}: time", yscale="log")
+            ax_e.set(xlabel="workers", ylabel="parallel efficiency", title=f"{scene}, {d}: efficiency",
+                     ylim=(0, 1.15))
+            for ax in (ax_t, ax_e):
+                ax.set_xticks(sorted({x for pts in by_dispatch[d].values() for x, _ in pts}))
+        handles, labels = axes[0][0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="center right", fontsize=7)
+        fig.tight_layout(rect=(0, 0, 0.8, 1))
         out = os.path.join(sys.argv[2], f"scaling_{scene}.png")
-        fig.savefig(out, dpi=110)
+        fig.savefig(out, dpi=100)
+        plt.close(fig)
         print(out)
     return 0
 
