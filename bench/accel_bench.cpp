@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
@@ -27,11 +28,7 @@
 namespace {
 
 using namespace cellrt;
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 
 struct FrameRays {
     std::vector<Ray> primary, shadow;
@@ -142,15 +139,9 @@ int main(int argc, char** argv) {
     nlohmann::json out = nlohmann::json::array();
     try {
         for (const std::string& name : scenes) {
-            std::string spec = name;
-            if (name.rfind("builtin:", 0) != 0) {
-                spec = (std::filesystem::path(scenes_dir) / name / (name + ".json")).string();
-                if (!std::filesystem::exists(spec)) {
-                    std::fprintf(stderr, "skipping %s: %s not found\n", name.c_str(), spec.c_str());
-                    continue;
-                }
-            }
-            const Scene scene = load_scene(spec);
+            const auto spec = bench::scene_spec(scenes_dir, name);
+            if (!spec) continue;
+            const Scene scene = load_scene(*spec);
             int w = scene.width, h = scene.height;
             if (!size.empty() && std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2) throw Error("--size must be WxH");
             const FrameRays rays = ray_kind == "frame" ? frame_rays(scene, w, h, 16)
@@ -164,11 +155,7 @@ int main(int argc, char** argv) {
             for (const std::string& text : configs) {
                 AccelConfig cfg = parse_accel_config(text);
                 cfg.threads = threads;
-                const auto kinds = accelerator_kinds();
-                if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
-                    std::fprintf(stderr, "skipping %s: not built into this binary\n", text.c_str());
-                    continue;
-                }
+                if (!bench::built_in(cfg.kind)) continue;
                 Result r;
                 r.config = text;
                 r.embree = cfg.kind == "embree";

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
@@ -24,11 +25,7 @@
 namespace {
 
 using namespace cellrt;
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 
 struct Point {
     std::string scene, config, dispatch;
@@ -72,23 +69,13 @@ int main(int argc, char** argv) {
         if (yardstick.empty() && parse_accel_config(c).kind == "embree") yardstick = c;
     try {
         for (const std::string& name : scenes) {
-            std::string spec = name;
-            if (name.rfind("builtin:", 0) != 0) {
-                spec = (std::filesystem::path(scenes_dir) / name / (name + ".json")).string();
-                if (!std::filesystem::exists(spec)) {
-                    std::fprintf(stderr, "skipping %s: %s not found\n", name.c_str(), spec.c_str());
-                    continue;
-                }
-            }
-            const Scene scene = load_scene(spec);
+            const auto spec = bench::scene_spec(scenes_dir, name);
+            if (!spec) continue;
+            const Scene scene = load_scene(*spec);
             scene_names.push_back(scene.name);
             for (const std::string& cfg_text : configs) {
                 const AccelConfig cfg = parse_accel_config(cfg_text);
-                const auto kinds = accelerator_kinds();
-                if (std::find(kinds.begin(), kinds.end(), cfg.kind) == kinds.end()) {
-                    std::fprintf(stderr, "skipping %s: not built into this binary\n", cfg.kind.c_str());
-                    continue;
-                }
+                if (!bench::built_in(cfg.kind)) continue;
                 const auto accel = make_accelerator(scene.triangles, cfg);
                 for (const std::string& d : dispatches)
                     for (int p : packets) {
