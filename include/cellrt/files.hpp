@@ -1,4 +1,5 @@
-// Output files are written whole or not at all, and replace nothing the user has unless asked.
+// File names and output files. Output files are written whole or not at all, and replace nothing the
+// user has unless asked.
 #pragma once
 
 #include <string>
@@ -11,5 +12,9 @@ namespace cellrt {
 // `overwrite`. Throws cellrt::Error naming the path on any failure (missing directory, no permission,
 // disk full).
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite);
+
+// The extension of `path` in lower case, with its dot (".png"), or "" when it has none: formats are
+// chosen by extension, whatever its case.
+std::string lower_extension(const std::string& path);
 
 }  // namespace cellrt

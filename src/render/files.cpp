@@ -1,5 +1,7 @@
 #include "cellrt/files.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -8,6 +10,12 @@
 
 namespace cellrt {
 
+std::string lower_extension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite) {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -15,7 +23,10 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     const fs::path target(path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");
-    const fs::path temp = dir / ("." + target.filename().string() + ".part" + std::to_string(::getpid()));
+    std::string temp_name = ".";  // appended piece by piece: GCC 12 warns wrongly on "." + string (PR 105651)
+    temp_name += target.filename().string();
+    temp_name += ".part" + std::to_string(::getpid());
+    const fs::path temp = dir / temp_name;
     {
         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
         if (!out) throw Error(path + ": cannot write in '" + dir.string() + "'");

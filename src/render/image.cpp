@@ -17,12 +17,6 @@
 namespace cellrt {
 namespace {
 
-std::string lower_extension(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    return ext;
-}
-
 std::string encode_png(const Image& image) {
     std::vector<std::uint8_t> rgb(static_cast<std::size_t>(image.width) * image.height * 3);
     for (std::size_t i = 0; i < image.pixels.size(); ++i)

@@ -1,24 +1,15 @@
 #include "cellrt/scene.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 
 #include "cellrt/builtin.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/files.hpp"
 #include "cellrt/loaders.hpp"
 
 namespace cellrt {
-namespace {
-
-std::string lower_extension(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    return ext;
-}
-
-}  // namespace
 
 Box3 Scene::bounds() const {
     Box3 b;
