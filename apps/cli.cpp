@@ -51,15 +51,6 @@ void print_stats(const AccelStats& s) {
     for (const auto& [k, v] : s.figures) std::printf("%-16s %s\n", k.c_str(), v.c_str());
 }
 
-std::pair<int, int> parse_size(const std::string& option, const std::string& text) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 65536 ||
-        h > 65536)
-        throw Error(option + " '" + text + "' must be WIDTHxHEIGHT with both in [1, 65536]");
-    return {w, h};
-}
-
 Progress::Progress() : enabled_(::isatty(STDERR_FILENO)) {}
 
 Progress::~Progress() {

@@ -47,9 +47,6 @@ struct AccelOptions {
 
 void print_stats(const AccelStats& s);
 
-// WIDTHxHEIGHT, both in [1, 65536]; throws cellrt::Error naming the option otherwise.
-std::pair<int, int> parse_size(const std::string& option, const std::string& text);
-
 
 // A one-line progress bar on stderr, shown only on a terminal and only once a render has run for a
 // second.

@@ -272,7 +272,7 @@ Runner add_cache_study(CLI::App& app) {
         for (const std::string& spec : o->scenes) {
             const Scene scene = load_scene(spec);
             int width = scene.width, height = scene.height;
-            if (!o->size.empty()) std::tie(width, height) = parse_size("--size", o->size);
+            if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
             const Workload w = sampled_frame(scene, width, height, o->packet, o->sample);
             std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): %zu "
                         "primary + %zu shadow rays of the frame's %llu\n",

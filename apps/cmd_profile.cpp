@@ -124,7 +124,7 @@ nlohmann::json to_json(const profile::EventCounts& c, std::uint64_t rays) {
 int run_child(const ProfileOptions& o) {
     const Scene scene = load_scene(o.scene);
     RenderOptions ro;
-    std::tie(ro.width, ro.height) = parse_size("--size", o.size);
+    std::tie(ro.width, ro.height) = parse_image_size("--size", o.size);
     ro.packet = o.packet;
     const auto accel = make_accelerator(scene.triangles, o.accel.config());
     profile::render_under_callgrind(scene, *accel, ro);
@@ -157,7 +157,7 @@ int run_profile(const ProfileOptions& o) {
     RenderOptions ro;
     ro.width = ro.height = kCallgrindEdge;
     if (hardware) ro.width = scene.width, ro.height = scene.height;
-    if (!o.size.empty()) std::tie(ro.width, ro.height) = parse_size("--size", o.size);
+    if (!o.size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o.size);
     ro.threads = 1;
     ro.packet = o.packet;
     ro.cancel = &g_cancel;

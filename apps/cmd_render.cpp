@@ -162,7 +162,7 @@ Runner add_render(CLI::App& app) {
         RenderOptions ro;
         ro.width = scene.width;
         ro.height = scene.height;
-        if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_size("--size", o->size);
+        if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o->size);
         ro.threads = o->accel.threads;
         ro.packet = o->packet;
         ro.dispatch = parse_dispatch(o->dispatch);

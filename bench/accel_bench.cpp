@@ -20,6 +20,7 @@
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/schedule.hpp"
@@ -142,8 +143,7 @@ int main(int argc, char** argv) {
             const auto spec = bench::scene_spec(scenes_dir, name);
             if (!spec) continue;
             const Scene scene = load_scene(*spec);
-            int w = scene.width, h = scene.height;
-            if (!size.empty() && std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2) throw Error("--size must be WxH");
+            auto [w, h] = size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", size);
             const FrameRays rays = ray_kind == "frame" ? frame_rays(scene, w, h, 16)
                                                        : random_rays(scene, static_cast<std::size_t>(w) * h);
             std::vector<Hit> exact(rays.primary.size());

@@ -19,6 +19,7 @@
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 
@@ -45,7 +46,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> dispatches{"pull", "mailbox"};
     std::vector<int> packets{2, 8, 16};
     std::vector<unsigned> workers;
-    int repeats = 3, size = 512;
+    int repeats = 3;
+    std::string size = "512x512";
     std::string csv_path, json_path;
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
@@ -55,7 +57,7 @@ int main(int argc, char** argv) {
     app.add_option("--packets", packets, "Packet edges P (P x P rays)")->capture_default_str();
     app.add_option("--workers", workers, "Worker counts (default 1..cores)");
     app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str()->check(CLI::Range(1, 100));
-    app.add_option("--size", size, "Image edge (square, as in the study)")->capture_default_str()->check(CLI::Range(1, 16384));
+    app.add_option("--size", size, "Image size WxH (the study's: 512x512)")->capture_default_str();
     app.add_option("--csv", csv_path, "Write every point as CSV");
     app.add_option("--json", json_path, "Write every point as JSON");
     CLI11_PARSE(app, argc, argv);
@@ -68,6 +70,7 @@ int main(int argc, char** argv) {
     for (const std::string& c : configs)
         if (yardstick.empty() && parse_accel_config(c).kind == "embree") yardstick = c;
     try {
+        const auto [width, height] = parse_image_size("--size", size);
         for (const std::string& name : scenes) {
             const auto spec = bench::scene_spec(scenes_dir, name);
             if (!spec) continue;
@@ -83,7 +86,8 @@ int main(int argc, char** argv) {
                         // drifts (shared hosts do) shifts every count alike and efficiencies hold.
                         auto options = [&](unsigned w) {
                             RenderOptions o;
-                            o.width = o.height = size;
+                            o.width = width;
+                            o.height = height;
                             o.threads = w;
                             o.packet = p;
                             o.dispatch = parse_dispatch(d);

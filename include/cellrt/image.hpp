@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cellrt/vec.hpp"
@@ -28,6 +29,10 @@ void write_image(const Image& image, const std::string& path, bool overwrite);
 
 // Reads a PFM written by write_image (for tests and comparisons).
 Image read_pfm(const std::string& path);
+
+// An image size written WIDTHxHEIGHT ("1920x1080"), both in [1, 65536]; throws cellrt::Error naming
+// `what` (an option, a field) otherwise.
+std::pair<int, int> parse_image_size(const std::string& what, const std::string& text);
 
 // The sRGB transfer function applied to one linear channel, clamped to [0, 1].
 float linear_to_srgb(float linear);

@@ -43,6 +43,15 @@ std::string encode_pfm(const Image& image) {
 
 }  // namespace
 
+std::pair<int, int> parse_image_size(const std::string& what, const std::string& text) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 65536 ||
+        h > 65536)
+        throw Error(what + " '" + text + "' must be WIDTHxHEIGHT with both in [1, 65536]");
+    return {w, h};
+}
+
 float linear_to_srgb(float linear) {
     const float c = std::clamp(linear, 0.f, 1.f);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
