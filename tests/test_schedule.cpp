@@ -1,12 +1,18 @@
 // The packet scheduler: every dispatch mode, worker count and packet size gives the same image.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
 
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "scenes.hpp"
+#include "schedule/worker_team.hpp"
 
 namespace cellrt {
 namespace {
@@ -87,6 +93,39 @@ TEST(Schedule, RejectsBadSettings) {
     EXPECT_THROW(PacketGrid(16, 16, 0), Error);
     EXPECT_THROW(parse_dispatch("push"), Error);
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
+}
+
+// The team behind both dispatch modes: every worker index runs once per run, all at the same time
+// (a job that waits for all the others would hang otherwise), worker w on the same thread from run
+// to run, the caller's `meanwhile` alongside, and a larger run after a smaller one grows the team.
+TEST(WorkerTeam, RunsEveryWorkerAtOnceOnKeptThreads) {
+    detail::WorkerTeam team;
+    std::vector<std::thread::id> first(4);
+    for (unsigned n : {4u, 2u, 4u, 6u}) {
+        std::atomic<unsigned> arrived{0};
+        std::mutex m;
+        std::vector<std::thread::id> ids(n);
+        std::set<std::thread::id> distinct;
+        bool meanwhile_ran = false;
+        team.run(
+            n, false,
+            [&](unsigned w) {
+                arrived.fetch_add(1);
+                while (arrived.load() < n) std::this_thread::yield();  // a barrier: needs all n at once
+                std::lock_guard lock(m);
+                ids[w] = std::this_thread::get_id();
+                distinct.insert(ids[w]);
+            },
+            [&] { meanwhile_ran = true; });
+        EXPECT_TRUE(meanwhile_ran);
+        EXPECT_EQ(arrived.load(), n);
+        EXPECT_EQ(distinct.size(), n);
+        EXPECT_EQ(distinct.count(std::this_thread::get_id()), 0u);
+        for (unsigned w = 0; w < std::min(n, 4u); ++w) {
+            if (first[w] == std::thread::id{}) first[w] = ids[w];
+            EXPECT_EQ(ids[w], first[w]) << "worker " << w << " moved to another thread";
+        }
+    }
 }
 
 }  // namespace

@@ -4,27 +4,11 @@
 #include <thread>
 #include <vector>
 
-#ifdef __linux__
-#include <pthread.h>
-#include <sched.h>
-#endif
-
 #include "cellrt/error.hpp"
+#include "worker_team.hpp"
 
 namespace cellrt {
 namespace {
-
-void pin_to_core(std::thread& t, unsigned core) {
-#ifdef __linux__
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(core % std::max(1u, std::thread::hardware_concurrency()), &set);
-    pthread_setaffinity_np(t.native_handle(), sizeof set, &set);
-#else
-    (void)t;
-    (void)core;
-#endif
-}
 
 void store(Image& image, const PixelRect& r, std::span<const Vec3> colours) {
     for (int y = r.y0; y < r.y1; ++y)
@@ -51,12 +35,7 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
             if (options.progress) options.progress(finished, grid.count());
         }
     };
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < workers; ++w) {
-        pool.emplace_back(work, w);
-        if (options.pin) pin_to_core(pool.back(), w);
-    }
-    for (auto& t : pool) t.join();
+    detail::worker_team().run(workers, options.pin, work);
     return done.load() == grid.count();
 }
 
@@ -92,40 +71,36 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
             box.state.store(Mailbox::done, std::memory_order_release);
         }
     };
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < workers; ++w) {
-        pool.emplace_back(work, w);
-        if (options.pin) pin_to_core(pool.back(), w);
-    }
-
-    // The master (the study's PPU): keeps the packet counter, posts each packet to an idle worker,
-    // and writes every finished packet's colours into the frame buffer.
+    // The master (the study's PPU), on the calling thread: keeps the packet counter, posts each packet
+    // to an idle worker, and writes every finished packet's colours into the frame buffer.
     std::size_t next = 0, done = 0, in_flight = 0;
-    for (;;) {
-        const bool more = next < grid.count() && !cancelled(options);
-        if (in_flight == 0 && !more) break;
-        bool progressed = false;
-        for (Mailbox& b : boxes) {
-            const int s = b.state.load(std::memory_order_acquire);
-            if (s == Mailbox::done) {
-                store(image, b.rect, std::span<const Vec3>(b.colours.data(), static_cast<std::size_t>(b.rect.pixels())));
-                b.state.store(Mailbox::idle, std::memory_order_relaxed);
-                --in_flight;
-                ++done;
-                progressed = true;
-                if (options.progress) options.progress(done, grid.count());
+    auto master = [&] {
+        for (;;) {
+            const bool more = next < grid.count() && !cancelled(options);
+            if (in_flight == 0 && !more) break;
+            bool progressed = false;
+            for (Mailbox& b : boxes) {
+                const int s = b.state.load(std::memory_order_acquire);
+                if (s == Mailbox::done) {
+                    store(image, b.rect, std::span<const Vec3>(b.colours.data(), static_cast<std::size_t>(b.rect.pixels())));
+                    b.state.store(Mailbox::idle, std::memory_order_relaxed);
+                    --in_flight;
+                    ++done;
+                    progressed = true;
+                    if (options.progress) options.progress(done, grid.count());
+                }
+                if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() && !cancelled(options)) {
+                    b.rect = grid.rect(next++);
+                    b.state.store(Mailbox::work, std::memory_order_release);
+                    ++in_flight;
+                    progressed = true;
+                }
             }
-            if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() && !cancelled(options)) {
-                b.rect = grid.rect(next++);
-                b.state.store(Mailbox::work, std::memory_order_release);
-                ++in_flight;
-                progressed = true;
-            }
+            if (!progressed) std::this_thread::yield();
         }
-        if (!progressed) std::this_thread::yield();
-    }
-    for (Mailbox& b : boxes) b.state.store(Mailbox::stop, std::memory_order_release);
-    for (auto& t : pool) t.join();
+        for (Mailbox& b : boxes) b.state.store(Mailbox::stop, std::memory_order_release);
+    };
+    detail::worker_team().run(workers, options.pin, work, master);
     return done == grid.count();
 }
 
