@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <ctime>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
