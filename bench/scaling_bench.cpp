@@ -3,8 +3,11 @@
 // and packet size. Every point is a warm-up frame and the median of --repeats frames, the worker
 // counts interleaved frame by frame; every table
 // shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
-// and packet size, measured in the same run. Writes Markdown tables to stdout and every point as
-// JSON and CSV; bench/plot_scaling.py draws the curves.
+// and packet size, measured in the same run. Where the efficiency goes is split in two: the share of
+// the frame the workers spent tracing (the rest is the schedule: waking, claiming, waiting at the
+// end) and how much longer the same packets took with N workers than with one (shared caches and
+// memory, the clock). Writes Markdown tables to stdout and every point as JSON and CSV;
+// bench/plot_scaling.py draws the curves.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -32,6 +35,7 @@ struct Point {
     int packet;
     unsigned workers;
     double seconds;
+    double busy_seconds;  // the workers' time tracing packets, summed over workers (median frame)
     std::uint64_t rays;
 };
 
@@ -94,15 +98,19 @@ int main(int argc, char** argv) {
                         };
                         Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
                         for (unsigned w : workers) render(scene, *accel, options(w), frame);  // warm-up
-                        std::map<unsigned, std::vector<double>> times;
+                        std::map<unsigned, std::vector<double>> times, busy;
                         RenderStats st;
                         for (int r = 0; r < repeats; ++r)
                             for (unsigned w : workers) {
                                 render(scene, *accel, options(w), frame, &st);
                                 times[w].push_back(st.seconds);
+                                double b = 0.0;
+                                for (const WorkerLoad& l : st.workers) b += l.busy_seconds;
+                                busy[w].push_back(b);
                             }
                         for (unsigned w : workers) {
-                            points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), st.primary_rays + st.shadow_rays});
+                            points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), median(busy[w]),
+                                              st.primary_rays + st.shadow_rays});
                             std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
                                          cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
                         }
@@ -122,15 +130,17 @@ int main(int argc, char** argv) {
         return nullptr;
     };
     // One table per configuration, dispatch and packet size, shaped like the study's: rows scenes,
-    // columns workers, seconds per frame with cellrt's rays/s over Embree's; then parallel efficiency.
+    // columns workers, seconds per frame with cellrt's rays/s over Embree's; then parallel efficiency,
+    // the tracing share at N workers and the packet time at N over that at 1.
     for (const std::string& config : configs)
         for (const std::string& d : dispatches)
             for (int p : packets) {
                 std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |",
                             config.c_str(), d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
                 for (unsigned w : workers) std::printf(" %u |", w);
-                std::printf(" efficiency at %u |\n|---|", workers.back());
-                for (std::size_t i = 0; i <= workers.size(); ++i) std::printf("---|");
+                std::printf(" efficiency at %u | tracing share at %u | packet time %u ÷ %u |\n|---|", workers.back(),
+                            workers.back(), workers.back(), workers.front());
+                for (std::size_t i = 0; i < workers.size() + 3; ++i) std::printf("---|");
                 std::printf("\n");
                 for (const std::string& scene : scene_names) {
                     std::printf("| %s |", scene.c_str());
@@ -144,9 +154,12 @@ int main(int argc, char** argv) {
                         else std::printf(" %.4f |", pt->seconds);
                     }
                     if (first && last)
-                        std::printf(" %.2f |\n", first->seconds * workers.front() / (last->seconds * workers.back()));
+                        std::printf(" %.2f | %.3f | %.3f |\n",
+                                    first->seconds * workers.front() / (last->seconds * workers.back()),
+                                    last->busy_seconds / (last->seconds * workers.back()),
+                                    last->busy_seconds / first->busy_seconds);
                     else
-                        std::printf(" – |\n");
+                        std::printf(" – | – | – |\n");
                 }
             }
 
@@ -154,7 +167,7 @@ int main(int argc, char** argv) {
     for (const Point& pt : points) {
         nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
                          {"packet", pt.packet}, {"workers", pt.workers}, {"seconds", pt.seconds},
-                         {"rays", pt.rays}};
+                         {"busy_seconds", pt.busy_seconds}, {"rays", pt.rays}};
         if (const Point* y = yardstick.empty() ? nullptr : find(pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;
         out.push_back(j);
@@ -162,11 +175,11 @@ int main(int argc, char** argv) {
     if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
     if (!csv_path.empty()) {
         std::ofstream csv(csv_path);
-        csv << "scene,config,dispatch,packet,workers,seconds,rays,embree_seconds\n";
+        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,rays,embree_seconds\n";
         for (const auto& j : out)
             csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
                 << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
-                << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+                << ',' << j["busy_seconds"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
     }
     return 0;
 }

@@ -1,6 +1,7 @@
 // The packet scheduler: every dispatch mode, worker count and packet size gives the same image.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cstring>
 #include <mutex>
@@ -11,6 +12,7 @@
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
+#include "cellrt/timer.hpp"
 #include "scenes.hpp"
 #include "schedule/worker_team.hpp"
 
@@ -68,6 +70,37 @@ TEST(Schedule, EveryPixelIsWrittenOnce) {
         }));
         for (int y = 0; y < 17; ++y)
             for (int x = 0; x < 23; ++x) ASSERT_EQ(image.at(x, y), (Vec3{float(x), float(y), 1.f})) << to_string(d);
+    }
+}
+
+// Each worker's load names the packets that worker traced, and its busy time covers the time they
+// took (each packet here takes at least 200 microseconds).
+TEST(Schedule, ReportsEachWorkersLoad) {
+    const PacketGrid grid(40, 24, 8);
+    Image image(40, 24);
+    for (Dispatch d : {Dispatch::pull, Dispatch::mailbox}) {
+        constexpr unsigned kWorkers = 3;
+        std::array<std::atomic<std::size_t>, kWorkers> traced{};
+        ScheduleOptions o;
+        o.dispatch = d;
+        o.workers = kWorkers;
+        std::vector<WorkerLoad> loads;
+        ASSERT_TRUE(run_packets(
+            grid, o, image,
+            [&](unsigned w, const PixelRect&, std::span<Vec3>) {
+                ++traced[w];
+                const Timer t;
+                while (t.seconds() < 200e-6) {}
+            },
+            &loads));
+        ASSERT_EQ(loads.size(), kWorkers) << to_string(d);
+        std::size_t packets = 0;
+        for (unsigned w = 0; w < kWorkers; ++w) {
+            EXPECT_EQ(loads[w].packets, traced[w].load()) << to_string(d) << " worker " << w;
+            EXPECT_GE(loads[w].busy_seconds, 200e-6 * static_cast<double>(loads[w].packets)) << to_string(d);
+            packets += loads[w].packets;
+        }
+        EXPECT_EQ(packets, grid.count()) << to_string(d);
     }
 }
 

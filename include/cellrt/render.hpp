@@ -31,6 +31,7 @@ struct RenderStats {
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
     TraversalCounters primary, shadow;  // filled when RenderOptions::count
+    std::vector<WorkerLoad> workers;    // what each worker traced, and for how long
 };
 
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,

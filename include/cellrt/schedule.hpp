@@ -61,11 +61,21 @@ struct ScheduleOptions {
 // Computes the colours of one packet (row-major over rect, rect.pixels() entries) on worker `worker`.
 using PacketTracer = std::function<void(unsigned worker, const PixelRect& rect, std::span<Vec3> colours)>;
 
+// What one worker did in a frame: the packets it traced and the time it spent tracing them (its
+// PacketTracer calls and, under pull dispatch, writing their colours). A frame of N workers that
+// takes T seconds leaves N * T - sum(busy) to the schedule itself: waking, claiming, waiting.
+struct WorkerLoad {
+    std::size_t packets = 0;
+    double busy_seconds = 0.0;
+};
+
 // Number of worker threads `options` asks for.
 unsigned worker_count(const ScheduleOptions& options);
 
-// Traces every packet of `grid` into `image` (which must be grid.width x grid.height).
-// Returns false when cancelled before all packets were traced.
-bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace);
+// Traces every packet of `grid` into `image` (which must be grid.width x grid.height); when `loads`
+// is given, it receives one WorkerLoad per worker. Returns false when cancelled before all packets
+// were traced.
+bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
+                 std::vector<WorkerLoad>* loads = nullptr);
 
 }  // namespace cellrt

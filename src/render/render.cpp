@@ -18,8 +18,9 @@ Vec3 sky(const Vec3& dir) {
     return Vec3{0.9f, 0.95f, 1.f} * (1.f - k) + Vec3{0.35f, 0.55f, 0.9f} * k;
 }
 
-// Buffers of one worker, allocated once per render, reused for every packet.
-struct PacketWork {
+// Buffers of one worker, allocated once per render, reused for every packet. On a cache line of its
+// own: workers update their vectors' ends and counters on every packet.
+struct alignas(64) PacketWork {
     std::vector<Ray> rays, shadow_rays;
     std::vector<Hit> hits;
     std::vector<std::uint8_t> occluded;
@@ -136,14 +137,19 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     for (PacketWork& w : work) w.reserve(packet_rays);
 
     Timer timer;
-    const bool complete = run_packets(grid, schedule, image, [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
-        trace_packet(scene, accel, camera, rect, options.count, work[w], out);
-    });
+    std::vector<WorkerLoad> loads;
+    const bool complete = run_packets(
+        grid, schedule, image,
+        [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
+            trace_packet(scene, accel, camera, rect, options.count, work[w], out);
+        },
+        &loads);
     if (!complete) throw Error("render cancelled");
     if (stats) {
         *stats = RenderStats{};
         stats->seconds = timer.seconds();
         stats->primary_rays = static_cast<std::uint64_t>(options.width) * options.height;
+        stats->workers = std::move(loads);
         for (const PacketWork& w : work) {
             stats->primary += w.primary;
             stats->shadow += w.shadow;

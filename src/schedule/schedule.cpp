@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cellrt/error.hpp"
+#include "cellrt/timer.hpp"
 #include "worker_team.hpp"
 
 namespace cellrt {
@@ -17,9 +18,26 @@ void store(Image& image, const PixelRect& r, std::span<const Vec3> colours) {
 
 bool cancelled(const ScheduleOptions& o) { return o.cancel && o.cancel->load(std::memory_order_relaxed); }
 
+// A worker's load, on a cache line of its own: each worker adds to it after every packet.
+struct alignas(64) PaddedLoad {
+    WorkerLoad load;
+};
+
+// Calls `trace_packet` and adds the packet and the time it took to `load`.
+template <class TracePacket>
+void timed(WorkerLoad& load, TracePacket&& trace_packet) {
+    const Timer timer;
+    trace_packet();
+    load.busy_seconds += timer.seconds();
+    ++load.packets;
+}
+
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
-              unsigned workers) {
-    std::atomic<std::size_t> next{0}, done{0};
+              std::vector<PaddedLoad>& loads) {
+    const auto workers = static_cast<unsigned>(loads.size());
+    // Apart, so that claiming a packet and reporting one do not contend for one cache line.
+    alignas(64) std::atomic<std::size_t> next{0};
+    alignas(64) std::atomic<std::size_t> done{0};
     // Allocated here: a worker that allocates gets a malloc arena of its own, on every frame.
     std::vector<std::vector<Vec3>> buffers(workers, std::vector<Vec3>(static_cast<std::size_t>(grid.packet) * grid.packet));
     auto work = [&](unsigned w) {
@@ -29,8 +47,10 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
             if (cancelled(options)) return;
             const PixelRect r = grid.rect(p);
             const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
-            trace(w, r, out);
-            store(image, r, out);
+            timed(loads[w].load, [&] {
+                trace(w, r, out);
+                store(image, r, out);
+            });
             const std::size_t finished = done.fetch_add(1, std::memory_order_relaxed) + 1;
             if (options.progress) options.progress(finished, grid.count());
         }
@@ -57,7 +77,8 @@ void poll(Ready&& ready) {
 }
 
 bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
-                 unsigned workers) {
+                 std::vector<PaddedLoad>& loads) {
+    const auto workers = static_cast<unsigned>(loads.size());
     std::vector<Mailbox> boxes(workers);
     for (Mailbox& b : boxes) b.colours.resize(static_cast<std::size_t>(grid.packet) * grid.packet);
 
@@ -67,7 +88,9 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
             int s;
             poll([&] { return (s = box.state.load(std::memory_order_acquire)) == Mailbox::work || s == Mailbox::stop; });
             if (s == Mailbox::stop) return;
-            trace(w, box.rect, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
+            timed(loads[w].load, [&] {
+                trace(w, box.rect, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
+            });
             box.state.store(Mailbox::done, std::memory_order_release);
         }
     };
@@ -147,11 +170,17 @@ unsigned worker_count(const ScheduleOptions& options) {
     return options.workers ? options.workers : std::max(1u, std::thread::hardware_concurrency());
 }
 
-bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace) {
+bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
+                 std::vector<WorkerLoad>* loads) {
     if (image.width != grid.width || image.height != grid.height) throw Error("frame buffer does not match the packet grid");
-    const unsigned workers = worker_count(options);
-    return options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, workers)
-                                              : run_mailbox(grid, options, image, trace, workers);
+    std::vector<PaddedLoad> padded(worker_count(options));
+    const bool complete = options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, padded)
+                                                             : run_mailbox(grid, options, image, trace, padded);
+    if (loads) {
+        loads->clear();
+        for (const PaddedLoad& p : padded) loads->push_back(p.load);
+    }
+    return complete;
 }
 
 }  // namespace cellrt
