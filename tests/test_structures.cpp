@@ -14,9 +14,10 @@ namespace cellrt {
 namespace {
 
 // Every exact structure path: KIND:TRAVERSAL for single rays, KIND+SIMD for the packet kernels of
-// each instruction set this machine runs.
+// each instruction set this machine runs; and the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
-    std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless"};
+    std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
+                                    "bih:branched@split=sah", "bih+auto@split=sah"};
     for (detail::Isa isa : detail::available_isas())
         for (const char* kind : {"kd", "bih"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;
@@ -26,7 +27,7 @@ const std::vector<std::string> kConfigs = exact_configs();
 std::string name_of(const std::string& config) {
     std::string s = config;
     std::replace(s.begin(), s.end(), ':', '_');
-    std::replace(s.begin(), s.end(), '+', '_');
+    for (const char c : {'+', '@', '='}) std::replace(s.begin(), s.end(), c, '_');
     return s;
 }
 

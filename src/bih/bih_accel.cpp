@@ -8,6 +8,7 @@ namespace cellrt::detail {
 BihBuildParams read_bih_params(const AccelConfig& config) {
     ParamReader in(config, "bih");
     BihBuildParams p;
+    p.split = in.get_choice("split", "global", {"global", "sah"}) == "sah" ? BihSplit::sah : BihSplit::global;
     p.leaf_size = in.get_int("leaf_size", p.leaf_size, 1, 1 << 20);
     p.max_depth = in.get_int("max_depth", p.max_depth, 1, kBihMaxDepth);
     p.empty_cut = in.get_number("empty_cut", p.empty_cut, 0.0, 1.0);

@@ -9,6 +9,13 @@
 // node is emitted, its empty child's plane at infinity. A node becomes a leaf at `leaf_size`
 // triangles, at `max_depth`, or when the grid cell can no longer be halved.
 //
+// With `split=sah` the plane comes instead from the surface area heuristic over kSahBins bins of the
+// triangles' centres on each axis (MacDonald & Booth 1990; binned as in Wald, "On fast Construction
+// of SAH-based Bounding Volume Hierarchies", 2007). A BIH child's cell is its parent's cell cut on the
+// split axis only, at the largest (left) or smallest (right) extent of its triangles, so that is the
+// cell each candidate is costed with. Empty space is still cut first, and the node stays a leaf when
+// no split is cheaper than testing its triangles.
+//
 // Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
 // known in advance. Large ranges are built as parallel tasks (accel/subtree.hpp keeps the layout
 // independent of the thread count).
@@ -29,6 +36,18 @@ namespace {
 
 constexpr std::size_t kParallelMin = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The SAH's bins per axis and its costs: a node visit and a triangle test, the kd-tree's default
+// costs (kd_tree.hpp), so that the two structures' reports compare.
+constexpr int kSahBins = 32;
+constexpr double kSahTraversal = 15.0, kSahIntersection = 20.0;
+constexpr std::uint32_t kSahMaxLeaf = 16;
+
+double area(const Box3& b) {
+    if (b.is_empty()) return 0.0;
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return 2.0 * (x * y + y * z + z * x);
+}
 
 int longest_axis(const Box3& b) {
     const Vec3 e = b.extent();
@@ -98,6 +117,7 @@ private:
             centres.extend(centres_[order_[i]]);
             objects.extend(boxes_[order_[i]]);
         }
+        if (p_.split == BihSplit::sah) return decide_sah(r, centres, objects);
         for (;;) {
             const int a = longest_axis(r.grid);
             const float split = 0.5f * (r.grid.lo[a] + r.grid.hi[a]);
@@ -115,25 +135,108 @@ private:
                 r.grid.lo[a] = split;
                 continue;
             }
-            const auto mid_it = std::partition(order_.begin() + r.begin, order_.begin() + r.end,
-                                               [&](std::uint32_t t) { return centres_[t][a] <= split; });
-            const auto mid = static_cast<std::uint32_t>(mid_it - order_.begin());
-            d.kind = Kind::split;
-            d.axis = a;
-            d.left_clip = -kInf;
-            d.right_clip = kInf;
-            for (std::uint32_t i = r.begin; i < mid; ++i) d.left_clip = std::max(d.left_clip, boxes_[order_[i]].hi[a]);
-            for (std::uint32_t i = mid; i < r.end; ++i) d.right_clip = std::min(d.right_clip, boxes_[order_[i]].lo[a]);
-            d.left = d.right = r;
-            d.left.end = mid;
-            d.right.begin = mid;
-            d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
-            d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
+            Decision d = split_at(r, a, [&](std::uint32_t t) { return centres_[t][a] <= split; });
             d.left.grid.hi[a] = split;
             d.right.grid.lo[a] = split;
-            d.left.depth = d.right.depth = r.depth + 1;
             return d;
         }
+    }
+
+    // Partitions the range in place into the triangles for which `goes_left` holds and the rest (both
+    // sides non-empty), with the clip planes at the two sides' extents on `a`.
+    template <class GoesLeft>
+    Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
+        const auto mid_it = std::partition(order_.begin() + r.begin, order_.begin() + r.end, goes_left);
+        const auto mid = static_cast<std::uint32_t>(mid_it - order_.begin());
+        Decision d;
+        d.kind = Kind::split;
+        d.axis = a;
+        d.left_clip = -kInf;
+        d.right_clip = kInf;
+        for (std::uint32_t i = r.begin; i < mid; ++i) d.left_clip = std::max(d.left_clip, boxes_[order_[i]].hi[a]);
+        for (std::uint32_t i = mid; i < r.end; ++i) d.right_clip = std::min(d.right_clip, boxes_[order_[i]].lo[a]);
+        d.left = d.right = r;
+        d.left.end = mid;
+        d.right.begin = mid;
+        d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
+        d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
+        d.left.depth = d.right.depth = r.depth + 1;
+        return d;
+    }
+
+    // The SAH split (see the top of this file). `centres` and `objects` bound the range's triangle
+    // centres and boxes.
+    Decision decide_sah(const Range& r, const Box3& centres, const Box3& objects) {
+        // Empty space first: the side of the cell with the largest empty fraction, beyond empty_cut.
+        int cut_axis = -1;
+        bool cut_high = false;
+        double cut_fraction = p_.empty_cut;
+        for (int a = 0; a < 3; ++a) {
+            const double width = double(r.box.hi[a]) - r.box.lo[a];
+            if (!(width > 0.0)) continue;
+            const double high = (double(r.box.hi[a]) - objects.hi[a]) / width, low = (double(objects.lo[a]) - r.box.lo[a]) / width;
+            if (high > cut_fraction) cut_axis = a, cut_high = true, cut_fraction = high;
+            if (low > cut_fraction) cut_axis = a, cut_high = false, cut_fraction = low;
+        }
+        if (cut_axis >= 0)
+            return cut_high ? cut(r, cut_axis, objects.hi[cut_axis], kInf, true)
+                            : cut(r, cut_axis, -kInf, objects.lo[cut_axis], false);
+
+        struct Bin {
+            std::uint32_t count = 0;
+            float hi = -kInf, lo = kInf;  // the extent of the bin's triangles on the axis
+        };
+        // A flat cell (all triangles on a line) has no area: its length serves instead.
+        const bool flat = !(area(r.box) > 0.0);
+        auto measure = [flat](const Box3& b) { return flat ? double(b.hi.x - b.lo.x) + (b.hi.y - b.lo.y) + (b.hi.z - b.lo.z) : area(b); };
+        const double cell_measure = measure(r.box);
+        double best_cost = kInf;
+        int best_axis = -1, best_bin = 0;
+        for (int a = 0; a < 3; ++a) {
+            const float lo = centres.lo[a], extent = centres.hi[a] - lo;
+            if (!(extent > 0.f)) continue;
+            const float scale = kSahBins / extent;
+            Bin bins[kSahBins];
+            for (std::uint32_t i = r.begin; i < r.end; ++i) {
+                const std::uint32_t t = order_[i];
+                Bin& b = bins[bin_of(centres_[t][a], lo, scale)];
+                ++b.count;
+                b.hi = std::max(b.hi, boxes_[t].hi[a]);
+                b.lo = std::min(b.lo, boxes_[t].lo[a]);
+            }
+            // Sweep from the right for the right sides' counts and extents, then from the left.
+            double right_cost[kSahBins];
+            std::uint32_t count = 0;
+            float right_lo = kInf;
+            for (int k = kSahBins - 1; k > 0; --k) {
+                count += bins[k].count;
+                right_lo = std::min(right_lo, bins[k].lo);
+                Box3 cell = r.box;
+                cell.lo[a] = std::max(cell.lo[a], right_lo);
+                right_cost[k] = count * measure(cell);
+            }
+            count = 0;
+            float left_hi = -kInf;
+            for (int k = 0; k < kSahBins - 1; ++k) {
+                count += bins[k].count;
+                left_hi = std::max(left_hi, bins[k].hi);
+                if (count == 0 || count == r.size()) continue;
+                Box3 cell = r.box;
+                cell.hi[a] = std::min(cell.hi[a], left_hi);
+                const double cost = kSahTraversal + kSahIntersection * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
+                if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
+            }
+        }
+        // A leaf when no split beats testing every triangle, up to kSahMaxLeaf triangles; beyond, the
+        // cheapest split even so (a leaf that large would be tested by every ray that reaches it).
+        const bool leaf_is_cheaper = !(best_cost < kSahIntersection * r.size());
+        if (best_axis < 0 || (leaf_is_cheaper && r.size() <= kSahMaxLeaf)) return Decision{};
+        const float lo = centres.lo[best_axis], scale = kSahBins / (centres.hi[best_axis] - lo);
+        return split_at(r, best_axis, [&](std::uint32_t t) { return bin_of(centres_[t][best_axis], lo, scale) <= best_bin; });
+    }
+
+    static int bin_of(float centre, float lo, float scale) {
+        return std::clamp(static_cast<int>((centre - lo) * scale), 0, kSahBins - 1);
     }
 
     // An empty-space node: every triangle in one child, bounded by `left_clip`/`right_clip`; the
@@ -203,12 +306,6 @@ struct Totals {
     int max_depth = 0;
     double cost = 0.0;
 };
-
-double area(const Box3& b) {
-    if (b.is_empty()) return 0.0;
-    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-    return 2.0 * (x * y + y * z + z * x);
-}
 
 // Walks the hierarchy with each node's box (the parent's box cut by the node's clip plane).
 void walk(const BihTree& tree, std::uint32_t index, const Box3& box, int depth, Totals& t) {

@@ -19,7 +19,14 @@ namespace cellrt::detail {
 inline constexpr int kBihMaxDepth = 64;
 
 // Build parameters (`-P NAME=VALUE`; docs/BIH.md).
+// How a node's split plane is chosen: the study's global heuristic (Wächter & Keller section 2.2),
+// or the surface area heuristic over binned centres (MacDonald & Booth 1990; binning after Wald
+// 2007), each candidate costed with the cells a BIH gives its children: the node's cell cut by one
+// clip plane on the split axis.
+enum class BihSplit { global, sah };
+
 struct BihBuildParams {
+    BihSplit split = BihSplit::global;
     // A node with at most this many triangles is a leaf.
     int leaf_size = 2;
     int max_depth = kBihMaxDepth;
