@@ -275,7 +275,8 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
     F tmin, tmax;
     I active = clip_lanes(L, start_box, tmin, tmax);
     if (!any(active)) return;
-    constexpr int kStack = 66;
+    // At most two entries per level (see below), plus one.
+    constexpr int kStack = 2 * std::max(kKdMaxDepth, kBihMaxDepth) + 2;
     LaneEntry stack[kStack];
     int sp = 0;
     std::uint32_t index = start;
@@ -298,12 +299,23 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
             const unsigned left_bits = bits(left), right_bits = bits(right);
             const bool go_left = left_bits != 0, go_right = right_bits != 0;
             if (go_left && go_right) {
-                if (right_first(L.neg[a], active)) {
-                    stack[sp++] = {n.children(), lmin, lmax, left};
-                    index = n.children() + 1, tmin = rmin, tmax = rmax, active = right;
-                } else {
-                    stack[sp++] = {n.children() + 1, rmin, rmax, right};
-                    index = n.children(), tmin = lmin, tmax = lmax, active = left;
+                // The majority's near child first. For a closest hit, lanes for which it is the far
+                // child visit it after the other one, from an entry of their own below it: every
+                // lane meets the cells in its own front-to-back order, as its single ray would, and
+                // stops as early. (Any hit gains nothing from the order and would pay the extra visits.)
+                const bool right_near = right_first(L.neg[a], active);
+                I late = splat_i(0);
+                if constexpr (!Query::kAnyHit) late = right_near ? right & ~L.neg[a] : left & L.neg[a];
+                const std::uint32_t first = n.children() + (right_near ? 1u : 0u);
+                const F first_min = right_near ? rmin : lmin, first_max = right_near ? rmax : lmax;
+                if (any(late)) stack[sp++] = {first, first_min, first_max, late};
+                if (right_near) stack[sp++] = {n.children(), lmin, lmax, left};
+                else stack[sp++] = {n.children() + 1, rmin, rmax, right};
+                index = first, tmin = first_min, tmax = first_max;
+                active = (right_near ? right : left) & ~late;
+                if (!any(active)) {
+                    at_leaf = false;  // only late lanes need the near child: take the far one first
+                    break;
                 }
             } else if (go_left) {
                 index = n.children(), tmin = lmin, tmax = lmax, active = left;
