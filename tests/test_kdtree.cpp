@@ -8,6 +8,7 @@
 
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
+#include "kdtree/kd_accel.hpp"
 #include "kdtree/kd_tree.hpp"
 #include "ray_suite.hpp"
 #include "scenes.hpp"
@@ -97,6 +98,17 @@ TEST(KdTree, ReportsItsBuild) {
         EXPECT_TRUE(f.count(key)) << key;
     EXPECT_EQ(f["traversal"], "branched");
     EXPECT_GE(std::stod(f["refs per tri"]), 1.0);
+}
+
+// Trees for SIMD packets weigh a traversal step as kKdPacketTraversalCost unless told otherwise;
+// single rays keep Wald & Havran's constant.
+TEST(KdTree, PacketTreesDefaultToTheirOwnTraversalCost) {
+    AccelConfig c = kd("");
+    EXPECT_EQ(detail::read_kd_params(c).traversal_cost, detail::KdBuildParams{}.traversal_cost);
+    c.simd = "auto";
+    EXPECT_EQ(detail::read_kd_params(c).traversal_cost, detail::kKdPacketTraversalCost);
+    c.params = {{"traversal_cost", "7"}};
+    EXPECT_EQ(detail::read_kd_params(c).traversal_cost, 7.0);
 }
 
 TEST(KdTree, RejectsBadParameters) {

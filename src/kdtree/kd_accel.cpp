@@ -8,7 +8,8 @@ namespace cellrt::detail {
 KdBuildParams read_kd_params(const AccelConfig& config) {
     ParamReader in(config, "kd");
     KdBuildParams p;
-    p.traversal_cost = in.get_number("traversal_cost", p.traversal_cost, 1e-6, 1e6);
+    const double traversal_default = config.simd == "off" ? p.traversal_cost : kKdPacketTraversalCost;
+    p.traversal_cost = in.get_number("traversal_cost", traversal_default, 1e-6, 1e6);
     p.intersection_cost = in.get_number("intersection_cost", p.intersection_cost, 1e-6, 1e6);
     p.empty_bonus = in.get_number("empty_bonus", p.empty_bonus, 0.0, 0.99);
     p.max_depth = in.get_int("max_depth", p.max_depth, 0, kKdMaxDepth);

@@ -25,10 +25,16 @@ inline constexpr int kKdMaxDepth = 60;
 
 enum class KdBuildMethod { hybrid, sweep, binned };
 
+// The traversal cost a tree for SIMD packets is built with by default: a packet tests a triangle on
+// all its lanes for about the price of one node step (its stack entries are whole lane vectors), so
+// a step weighs three times the single-ray constant. Measured: docs/BENCHMARKS.md.
+inline constexpr double kKdPacketTraversalCost = 45.0;
+
 // Build parameters. Names are those of `-P NAME=VALUE`; defaults and ranges are documented in
 // docs/KDTREE.md and validated in kd_accel.cpp.
 struct KdBuildParams {
-    // Cost of one traversal step and of one triangle test (Wald & Havran's constants).
+    // Cost of one traversal step and of one triangle test (Wald & Havran's constants). Trees for
+    // SIMD packets default to kKdPacketTraversalCost instead (read_kd_params).
     double traversal_cost = 15.0;
     double intersection_cost = 20.0;
     // A split with an empty side costs (1 - empty_bonus) times its SAH value (Mitsuba: 0.1; Wald &
