@@ -194,8 +194,8 @@ private:
         int best_axis = -1, best_bin = 0;
         for (int a = 0; a < 3; ++a) {
             const float lo = centres.lo[a], extent = centres.hi[a] - lo;
-            if (!(extent > 0.f)) continue;
             const float scale = kSahBins / extent;
+            if (!(extent > 0.f) || !std::isfinite(scale)) continue;  // no extent, or too little to bin
             Bin bins[kSahBins];
             for (std::uint32_t i = r.begin; i < r.end; ++i) {
                 const std::uint32_t t = order_[i];
@@ -236,7 +236,7 @@ private:
     }
 
     static int bin_of(float centre, float lo, float scale) {
-        return std::clamp(static_cast<int>((centre - lo) * scale), 0, kSahBins - 1);
+        return static_cast<int>(std::clamp((centre - lo) * scale, 0.f, static_cast<float>(kSahBins - 1)));
     }
 
     // An empty-space node: every triangle in one child, bounded by `left_clip`/`right_clip`; the
