@@ -1,0 +1,34 @@
+#!/usr/bin/env python3
+"""One Markdown table of cellrt_scaling's JSON: rows scenes, columns every configuration at every
+worker count, each cell its rays per second over the yardstick's (the JSON's embree_seconds: the
+first embree configuration of the run, same workers, dispatch and packet size).
+
+usage: bench/scaling_tables.py scaling.json [CONFIG ...]   (only the named configurations, if given)
+"""
+import json
+import sys
+
+
+def main() -> int:
+    if len(sys.argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    with open(sys.argv[1], encoding="utf-8") as f:
+        points = json.load(f)
+    only = sys.argv[2:]
+    configs = only or list(dict.fromkeys(p["config"] for p in points))
+    workers = sorted({p["workers"] for p in points})
+    scenes = list(dict.fromkeys(p["scene"] for p in points))
+    ratio = {(p["scene"], p["config"], p["workers"]): p["embree_seconds"] / p["seconds"]
+             for p in points if "embree_seconds" in p}
+    columns = [(c, w) for c in configs for w in workers]
+    print("| scene | " + " | ".join(f"{c}, {w} worker{'s' if w > 1 else ''}" for c, w in columns) + " |")
+    print("|---|" + "---|" * len(columns))
+    for s in scenes:
+        cells = [f"{ratio[(s, c, w)]:.2f}" if (s, c, w) in ratio else "–" for c, w in columns]
+        print(f"| {s} | " + " | ".join(cells) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
