@@ -25,13 +25,13 @@ bool bih_leaf(const BihNode& leaf, Memory& mem, const TraversalRay& r, Query& q,
     return false;
 }
 
+// `_from` traverses the subtree of node `index` for the ray's interval [tmin, tmax] in that cell (the
+// SIMD packets hand a lane over to it when the lane is the last one left in a subtree).
 template <class Query, class Memory, class Counters>
-bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    float tmin, tmax;
-    if (!r.clip(tree.bounds, tmin, tmax)) return false;
+bool bih_traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
+                                float tmin, float tmax) {
     StackEntry stack[kBihMaxDepth + 1];
     int sp = 0;
-    std::uint32_t index = 0;
     for (;;) {
         BihNode n = mem.node(index);
         bool reached_leaf = true;
@@ -59,6 +59,12 @@ bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay&
         if (reached_leaf && bih_leaf(n, mem, r, q, c)) return true;
         if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
     }
+}
+
+template <class Query, class Memory, class Counters>
+bool bih_traverse_branched(const BihTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    float tmin, tmax;
+    return r.clip(tree.bounds, tmin, tmax) && bih_traverse_branched_from(mem, r, q, c, 0, tmin, tmax);
 }
 
 // Both children's entries are written, far first, and the stack pointer moves by the two comparison

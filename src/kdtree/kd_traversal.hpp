@@ -46,14 +46,14 @@ bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, C
 
 // Classic stack traversal (pbrt's, Wald's): entries (node, tmin, tmax); the near child is the one on
 // the side the direction points from, the far one is pushed when the ray reaches it.
+// `_from` traverses the subtree of node `index` for the ray's interval [tmin, tmax] in that cell (the
+// SIMD packets hand a lane over to it when the lane is the last one left in a subtree).
 template <class Query, class Memory, class Counters>
-bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    float tmin, tmax;
-    if (!r.clip(tree.bounds, tmin, tmax)) return false;
+bool kd_traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
+                               float tmin, float tmax) {
     Mailbox tested;
     StackEntry stack[kKdMaxDepth + 1];
     int sp = 0;
-    std::uint32_t index = 0;
     for (;;) {
         KdNode n = mem.node(index);
         while (!n.is_leaf()) {
@@ -77,6 +77,12 @@ bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r
         if (kd_leaf(n, mem, r, q, c, tested)) return true;
         if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
     }
+}
+
+template <class Query, class Memory, class Counters>
+bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+    float tmin, tmax;
+    return r.clip(tree.bounds, tmin, tmax) && kd_traverse_branched_from(mem, r, q, c, 0, tmin, tmax);
 }
 
 // The study's branchless traversal (section 4.5, after Havran 2007): at an inner node both entries

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -16,6 +17,8 @@
 #endif
 
 #include "accel/traversal.hpp"
+#include "bih/bih_traversal.hpp"
+#include "kdtree/kd_traversal.hpp"
 #include "packet.hpp"
 
 namespace cellrt::detail {

@@ -198,6 +198,15 @@ struct ClosestLanes {
         for (int i = 0; i < L.count; ++i)
             out[i] = best_prim[i] == kNoHit ? Hit{} : Hit{best_t[i], best_prim[i], best_u[i], best_v[i]};
     }
+
+    // Lane i's query as a single ray's, run by `traverse`, and its answer taken back.
+    template <class Traverse>
+    void single(int i, const TraversalRay& r, Traverse&& traverse) {
+        ClosestHit q(r);
+        q.best = Hit{best_t[i], best_prim[i], best_u[i], best_v[i]};
+        traverse(q);
+        best_t[i] = q.best.t, best_prim[i] = q.best.prim, best_u[i] = q.best.u, best_v[i] = q.best.v;
+    }
 };
 
 // Any hit per lane: a lane is finished at its first triangle with tnear <= t <= tfar.
@@ -220,6 +229,12 @@ struct AnyLanes {
     void store(const Lanes& L, std::uint8_t* out) const {
         for (int i = 0; i < L.count; ++i) out[i] = occluded[i] ? 1 : 0;
     }
+
+    template <class Traverse>
+    void single(int i, const TraversalRay& r, Traverse&& traverse) {
+        AnyHit q(r);
+        if (traverse(q)) occluded[i] = -1;
+    }
 };
 
 // Work counters: lane visits, so that the figures per ray compare with the single-ray kernels'.
@@ -233,6 +248,16 @@ struct LaneCounters {
     }
     void triangle(I active) const {
         if (sum) sum->triangles += static_cast<unsigned>(__builtin_popcount(bits(active)));
+    }
+    // Runs fn(counters) with the single-ray kernels' counters adding to the same sum.
+    template <class Fn>
+    auto single(Fn&& fn) const {
+        if (sum) {
+            WorkCounters c{*sum};
+            return fn(c);
+        }
+        NoCounters c;
+        return fn(c);
     }
 };
 
@@ -269,9 +294,41 @@ inline void split_lanes(const Lanes& L, int a, F t_left_ends, F t_right_starts, 
 // One packet through a kd-tree or a BIH from `start` (a node whose cell is `start_box`). The two
 // structures differ only in their inner nodes (one plane, or two clip planes) and their leaves
 // (indices into the scene's triangles, or ranges of the BIH's reordered ones).
+// The last lane left in a subtree goes on as a single ray: lane `i` (ray `r`) through the subtree of
+// node `index` with its interval [tmin, tmax] there, by the branched single-ray kernel, which visits
+// what the lane would and tests triangles the same way, at a scalar step's price.
 template <class Tree, class Query>
-inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes& L, Query& q, std::uint32_t start,
-                        const Box3& start_box, LaneCounters c) {
+[[gnu::noinline]] void trace_single_lane(const Tree& tree, const Triangle* triangles, const TraversalRay& r, int i,
+                                         Query& q, std::uint32_t index, float tmin, float tmax, LaneCounters c) {
+    q.single(i, r, [&](auto& single_query) {
+        return c.single([&](auto& counters) {
+            if constexpr (std::is_same_v<Tree, KdTree>) {
+                DirectMemory<KdNode> mem{tree.nodes.data(), tree.indices.data(), triangles};
+                return kd_traverse_branched_from(mem, r, single_query, counters, index, tmin, tmax);
+            } else {
+                DirectMemory<BihNode> mem{tree.nodes.data(), tree.prims.data(), tree.triangles.data()};
+                return bih_traverse_branched_from(mem, r, single_query, counters, index, tmin, tmax);
+            }
+        });
+    });
+}
+
+// Lanes whose directions point into opposite half-spaces on every axis: no view frustum or set of
+// rays toward one light does that, random rays almost always do.
+inline bool incoherent(const Lanes& L) {
+    for (int a = 0; a < 3; ++a)
+        if (!any(L.valid & L.neg[a]) || !any(L.valid & ~L.neg[a])) return false;
+    return true;
+}
+
+// `kHandOver`: whether a lane left alone in a subtree goes on as a single ray (trace_single_lane).
+// Worth it for incoherent lanes, which soon spread over the tree: a scalar step is cheaper than a
+// packet step for one lane. Coherent packets are traced without it: where they leave a lane alone
+// (silhouettes) the lane's next steps are few and the hand-over costs more than it saves (frames
+// 2 to 14% slower with it).
+template <bool kHandOver, class Tree, class Query>
+inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes& L, const Ray* rays, Query& q,
+                        std::uint32_t start, const Box3& start_box, LaneCounters c) {
     F tmin, tmax;
     I active = clip_lanes(L, start_box, tmin, tmax);
     if (!any(active)) return;
@@ -280,10 +337,20 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
     LaneEntry stack[kStack];
     int sp = 0;
     std::uint32_t index = start;
+    [[maybe_unused]] std::optional<TraversalRay> single_rays[kHandOver ? kLanes : 1];  // made on first use
     for (;;) {
         auto n = tree.nodes[index];
         bool at_leaf = true;
         while (!n.is_leaf()) {
+            if constexpr (kHandOver) {
+                if (const unsigned b = bits(active); (b & (b - 1)) == 0) {  // one lane left
+                    const int i = __builtin_ctz(b);
+                    if (!single_rays[i]) single_rays[i].emplace(rays[i], tree.bounds);
+                    trace_single_lane(tree, triangles, *single_rays[i], i, q, index, tmin[i], tmax[i], c);
+                    at_leaf = false;
+                    break;
+                }
+            }
             c.node(active);
             const int a = n.axis();
             F lmin, lmax, rmin, rmax;
@@ -463,7 +530,11 @@ inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<c
         const std::uint32_t start = count > 1 ? entry_point(tree, std::span<const Lanes>(groups, count), box) : 0;
         for (std::size_t g = 0; g < count; ++g) {
             Query q(groups[g]);
-            trace_lanes(tree, triangles, groups[g], q, start, box, LaneCounters{counters});
+            const Ray* group_rays = rays.data() + begin + g * kLanes;
+            if (incoherent(groups[g]))
+                trace_lanes<true>(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
+            else
+                trace_lanes<false>(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
             q.store(groups[g], out + begin + g * kLanes);
         }
     }
