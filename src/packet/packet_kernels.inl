@@ -425,6 +425,15 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
     }
 }
 
+// The incoherent instantiation out of line, so that the coherent one's caller is compiled as if it
+// were the only one.
+template <class Tree, class Query>
+[[gnu::noinline]] void trace_incoherent_lanes(const Tree& tree, const Triangle* triangles, const Lanes& L,
+                                              const Ray* rays, Query& q, std::uint32_t start, const Box3& start_box,
+                                              LaneCounters c) {
+    trace_lanes<true>(tree, triangles, L, rays, q, start, start_box, c);
+}
+
 inline float min_of(F x) {
     float m = x[0];
     for (int i = 1; i < kLanes; ++i) m = std::min(m, x[i]);
@@ -532,7 +541,7 @@ inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<c
             Query q(groups[g]);
             const Ray* group_rays = rays.data() + begin + g * kLanes;
             if (incoherent(groups[g]))
-                trace_lanes<true>(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
+                trace_incoherent_lanes(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
             else
                 trace_lanes<false>(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
             q.store(groups[g], out + begin + g * kLanes);
