@@ -4,8 +4,9 @@
 // The rays of a scene are those of one frame at the view's size: one primary ray per pixel, in 16 x 16
 // packets in the order the renderer traces them, and one shadow ray toward the light per primary hit
 // (hits found by an exact structure, so every configuration traces the very same shadow rays).
-// Each configuration is built `--builds` times (median reported) and traced after a warm-up pass
-// `--repeats` times (median per ray kind), single-threaded unless `--threads` says otherwise.
+// Each configuration is built `--builds` times (median reported); then, after a warm-up pass each,
+// the configurations are traced in turn, `--repeats` rounds (median per ray kind), single-threaded
+// unless `--threads` says otherwise.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -150,53 +151,69 @@ int main(int argc, char** argv) {
 
             std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
                         scene.triangles.size(), w, h, rays.primary.size(), rays.shadow.size());
-            std::vector<Result> results;
+            // Every configuration is built first; then the timed passes go round the configurations
+            // (primary and shadow rays of each in turn, `repeats` rounds), so that a slow spell of a
+            // shared machine falls on all of them alike and the ratios hold.
+            struct Entry {
+                Result r;
+                std::unique_ptr<Accelerator> accel;
+                std::vector<double> primary_s, shadow_s;
+            };
+            std::vector<Entry> entries;
             for (const std::string& text : configs) {
                 AccelConfig cfg = parse_accel_config(text);
                 cfg.threads = threads;
                 if (!bench::built_in(cfg.kind)) continue;
-                Result r;
-                r.config = text;
-                r.embree = cfg.kind == "embree";
+                Entry e;
+                e.r.config = text;
+                e.r.embree = cfg.kind == "embree";
                 std::vector<double> build_times;
-                std::unique_ptr<Accelerator> accel;
                 try {
                     for (int b = 0; b < builds; ++b) {
-                        accel.reset();
-                        accel = make_accelerator(scene.triangles, cfg);
-                        build_times.push_back(accel->stats().build_seconds);
+                        e.accel.reset();
+                        e.accel = make_accelerator(scene.triangles, cfg);
+                        build_times.push_back(e.accel->stats().build_seconds);
                     }
-                } catch (const Error& e) {  // e.g. a packet width this processor lacks
-                    std::fprintf(stderr, "skipping %s: %s\n", text.c_str(), e.what());
+                } catch (const Error& err) {  // e.g. a packet width this processor lacks
+                    std::fprintf(stderr, "skipping %s: %s\n", text.c_str(), err.what());
                     continue;
                 }
-                r.build_s = median(build_times);
-                r.memory_mib = static_cast<double>(accel->stats().memory_bytes) / (1024.0 * 1024.0);
-                std::vector<Hit> hits(rays.primary.size());
-                std::vector<std::uint8_t> occluded(rays.shadow.size());
-                const std::size_t bs = static_cast<std::size_t>(batch);
-                auto primary = [&](std::size_t i, std::size_t n) {
-                    accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
-                };
-                auto shadow = [&](std::size_t i, std::size_t n) {
-                    accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
-                };
-                const bool cpu = clock == "cpu";
-                timed_pass(rays.primary.size(), bs, cpu, primary);
-                timed_pass(rays.shadow.size(), bs, cpu, shadow);
-                std::vector<double> tp, ts;
-                for (int k = 0; k < repeats; ++k) {
-                    tp.push_back(timed_pass(rays.primary.size(), bs, cpu, primary));
-                    ts.push_back(timed_pass(rays.shadow.size(), bs, cpu, shadow));
+                e.r.build_s = median(build_times);
+                e.r.memory_mib = static_cast<double>(e.accel->stats().memory_bytes) / (1024.0 * 1024.0);
+                entries.push_back(std::move(e));
+            }
+            std::vector<Hit> hits(rays.primary.size());
+            std::vector<std::uint8_t> occluded(rays.shadow.size());
+            const std::size_t bs = static_cast<std::size_t>(batch);
+            const bool cpu = clock == "cpu";
+            auto passes = [&](Entry& e) {
+                const double tp = timed_pass(rays.primary.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
+                    e.accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
+                });
+                const double ts = timed_pass(rays.shadow.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
+                    e.accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
+                });
+                return std::pair{tp, ts};
+            };
+            for (Entry& e : entries) passes(e);  // warm-up
+            for (int k = 0; k < repeats; ++k)
+                for (Entry& e : entries) {
+                    const auto [tp, ts] = passes(e);
+                    e.primary_s.push_back(tp);
+                    e.shadow_s.push_back(ts);
                 }
-                r.primary_s = median(tp);
-                r.shadow_s = median(ts);
-                accel->intersect(rays.primary, hits, &r.primary_work);
-                accel->occluded(rays.shadow, occluded, &r.shadow_work);
+            std::vector<Result> results;
+            for (Entry& e : entries) {
+                Result& r = e.r;
+                r.primary_s = median(e.primary_s);
+                r.shadow_s = median(e.shadow_s);
+                e.accel->intersect(rays.primary, hits, &r.primary_work);
+                e.accel->occluded(rays.shadow, occluded, &r.shadow_work);
                 for (std::size_t i = 0; i < hits.size(); ++i) r.differing += !(hits[i].prim == exact[i].prim);
                 results.push_back(r);
-                std::fprintf(stderr, "%s %s done\n", scene.name.c_str(), text.c_str());
+                e.accel.reset();
             }
+            std::fprintf(stderr, "%s done\n", scene.name.c_str());
 
             // Ratios to Embree in this run: builds to its first configuration (its default build),
             // rays per second to rtcIntersect1 (`embree:single`) and to its fastest configuration.
