@@ -151,7 +151,7 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("--dispatch", o->dispatch, "How packets reach workers: pull (shared counter) or mailbox (the "
                                                "study's master)")
         ->capture_default_str();
-    cmd->add_flag("--pin", o->pin, "Pin worker i to core i");
+    cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
     cmd->add_option("--stats", o->stats, "Write the run's figures (and the local store's) as JSON to FILE");
     return [o] {

@@ -1,13 +1,13 @@
 // The study's scaling measurement (its Tables 5-1 and 5-2), with Embree alongside: seconds per frame
 // (512 x 512, primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode
-// and packet size. Every point is a warm-up frame and the median of --repeats frames, the worker
-// counts interleaved frame by frame; every table
+// and packet size. Every point is a warm-up frame and the median of --repeats frames, each timed
+// frame the second of two drawn back to back, the worker counts interleaved pair by pair; every table
 // shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
-// and packet size, measured in the same run. Where the efficiency goes is split in two: the share of
-// the frame the workers spent tracing (the rest is the schedule: waking, claiming, waiting at the
-// end) and how much longer the same packets took with N workers than with one (shared caches and
-// memory, the clock). Writes Markdown tables to stdout and every point as JSON and CSV;
-// bench/plot_scaling.py draws the curves.
+// and packet size, measured in the same run. Where the efficiency goes is split: the share of the
+// workers' time spent tracing and what the schedule took of the rest (waking the workers, between
+// packets, waiting for the last one at the end), and how much longer the same packets took with N
+// workers than with one (shared caches and memory, the clock). Writes Markdown tables to stdout and
+// every point as JSON and CSV; bench/plot_scaling.py draws the curves.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -35,7 +35,9 @@ struct Point {
     int packet;
     unsigned workers;
     double seconds;
-    double busy_seconds;  // the workers' time tracing packets, summed over workers (median frame)
+    // Summed over workers, each the median over frames: time tracing packets, time from the frame's
+    // start to each worker's start, time from each worker's finish to the frame's end.
+    double busy_seconds, started_seconds, waiting_seconds;
     std::uint64_t rays;
 };
 
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
     int repeats = 3;
     std::string size = "512x512";
     std::string csv_path, json_path;
+    int idle_spin = static_cast<int>(kDefaultIdleSpin.count());
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
     app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
@@ -61,6 +64,9 @@ int main(int argc, char** argv) {
     app.add_option("--workers", workers, "Worker counts (default 1..cores)");
     app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str()->check(CLI::Range(1, 100));
     app.add_option("--size", size, "Image size WxH (the study's: 512x512)")->capture_default_str();
+    app.add_option("--idle-spin-us", idle_spin, "Microseconds the workers poll for the next frame before sleeping")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1000000));
     app.add_option("--csv", csv_path, "Write every point as CSV");
     app.add_option("--json", json_path, "Write every point as JSON");
     CLI11_PARSE(app, argc, argv);
@@ -94,23 +100,34 @@ int main(int argc, char** argv) {
                             o.threads = w;
                             o.packet = p;
                             o.dispatch = parse_dispatch(d);
+                            o.idle_spin = std::chrono::microseconds(idle_spin);
                             return o;
                         };
                         Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
                         for (unsigned w : workers) render(scene, *accel, options(w), frame);  // warm-up
-                        std::map<unsigned, std::vector<double>> times, busy;
+                        std::map<unsigned, std::vector<double>> times, busy, started, waiting;
                         RenderStats st;
                         for (int r = 0; r < repeats; ++r)
                             for (unsigned w : workers) {
+                                // Frames drawn back to back, as a renderer draws them: the timed frame
+                                // follows one with the same workers, so it finds them still polling
+                                // (RenderOptions::idle_spin), not asleep after other worker counts.
+                                render(scene, *accel, options(w), frame);
                                 render(scene, *accel, options(w), frame, &st);
                                 times[w].push_back(st.seconds);
-                                double b = 0.0;
-                                for (const WorkerLoad& l : st.workers) b += l.busy_seconds;
+                                double b = 0.0, s = 0.0, e = 0.0;
+                                for (const WorkerLoad& l : st.workers) {
+                                    b += l.busy_seconds;
+                                    s += l.started_seconds;
+                                    e += std::max(0.0, st.seconds - l.finished_seconds);
+                                }
                                 busy[w].push_back(b);
+                                started[w].push_back(s);
+                                waiting[w].push_back(e);
                             }
                         for (unsigned w : workers) {
                             points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), median(busy[w]),
-                                              st.primary_rays + st.shadow_rays});
+                                              median(started[w]), median(waiting[w]), st.primary_rays + st.shadow_rays});
                             std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
                                          cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
                         }
@@ -130,22 +147,20 @@ int main(int argc, char** argv) {
         return nullptr;
     };
     // One table per configuration, dispatch and packet size, shaped like the study's: rows scenes,
-    // columns workers, seconds per frame with cellrt's rays/s over Embree's; then parallel efficiency,
-    // the tracing share at N workers and the packet time at N over that at 1.
+    // columns workers, seconds per frame with cellrt's rays/s over Embree's, and the parallel
+    // efficiency at the most workers; then where the time of the most workers went.
+    const unsigned one = workers.front(), most = workers.back();
     for (const std::string& config : configs)
         for (const std::string& d : dispatches)
             for (int p : packets) {
                 std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |",
                             config.c_str(), d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
                 for (unsigned w : workers) std::printf(" %u |", w);
-                std::printf(" efficiency at %u | tracing share at %u | packet time %u ÷ %u |\n|---|", workers.back(),
-                            workers.back(), workers.back(), workers.front());
-                for (std::size_t i = 0; i < workers.size() + 3; ++i) std::printf("---|");
+                std::printf(" efficiency at %u |\n|---|", most);
+                for (std::size_t i = 0; i <= workers.size(); ++i) std::printf("---|");
                 std::printf("\n");
                 for (const std::string& scene : scene_names) {
                     std::printf("| %s |", scene.c_str());
-                    const Point* first = find(scene, config, d, p, workers.front());
-                    const Point* last = find(scene, config, d, p, workers.back());
                     for (unsigned w : workers) {
                         const Point* pt = find(scene, config, d, p, w);
                         const Point* y = yardstick.empty() ? nullptr : find(scene, yardstick, d, p, w);
@@ -153,13 +168,27 @@ int main(int argc, char** argv) {
                         else if (y) std::printf(" %.4f (%.2f×) |", pt->seconds, y->seconds / pt->seconds);
                         else std::printf(" %.4f |", pt->seconds);
                     }
-                    if (first && last)
-                        std::printf(" %.2f | %.3f | %.3f |\n",
-                                    first->seconds * workers.front() / (last->seconds * workers.back()),
-                                    last->busy_seconds / (last->seconds * workers.back()),
-                                    last->busy_seconds / first->busy_seconds);
-                    else
-                        std::printf(" – | – | – |\n");
+                    const Point* first = find(scene, config, d, p, one);
+                    const Point* last = find(scene, config, d, p, most);
+                    if (first && last) std::printf(" %.2f |\n", first->seconds * one / (last->seconds * most));
+                    else std::printf(" – |\n");
+                }
+                // The workers' time at the most workers (most x seconds), in shares: tracing packets,
+                // and the schedule's parts; efficiency is about the tracing share over the packet time.
+                std::printf("\nWhere the %u workers' time went (shares of %u × the frame):\n\n"
+                            "| scene | tracing | waking | between packets | waiting at the end | packet time %u ÷ %u |\n"
+                            "|---|---|---|---|---|---|\n",
+                            most, most, most, one);
+                for (const std::string& scene : scene_names) {
+                    const Point* first = find(scene, config, d, p, one);
+                    const Point* last = find(scene, config, d, p, most);
+                    if (!first || !last) continue;
+                    const double all = last->seconds * most;
+                    const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
+                                 waiting = last->waiting_seconds / all;
+                    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", scene.c_str(), tracing, waking,
+                                std::max(0.0, 1.0 - tracing - waking - waiting), waiting,
+                                last->busy_seconds / first->busy_seconds);
                 }
             }
 
@@ -167,7 +196,8 @@ int main(int argc, char** argv) {
     for (const Point& pt : points) {
         nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
                          {"packet", pt.packet}, {"workers", pt.workers}, {"seconds", pt.seconds},
-                         {"busy_seconds", pt.busy_seconds}, {"rays", pt.rays}};
+                         {"busy_seconds", pt.busy_seconds}, {"started_seconds", pt.started_seconds},
+                         {"waiting_seconds", pt.waiting_seconds}, {"rays", pt.rays}};
         if (const Point* y = yardstick.empty() ? nullptr : find(pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;
         out.push_back(j);
@@ -175,11 +205,13 @@ int main(int argc, char** argv) {
     if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
     if (!csv_path.empty()) {
         std::ofstream csv(csv_path);
-        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,rays,embree_seconds\n";
+        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,rays,"
+               "embree_seconds\n";
         for (const auto& j : out)
             csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
                 << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
-                << ',' << j["busy_seconds"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+                << ',' << j["busy_seconds"] << ',' << j["started_seconds"]
+                << ',' << j["waiting_seconds"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
     }
     return 0;
 }

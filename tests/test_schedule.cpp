@@ -3,6 +3,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <mutex>
 #include <set>
@@ -18,6 +19,8 @@
 
 namespace cellrt {
 namespace {
+
+using namespace std::chrono_literals;
 
 bool same_bits(const Image& a, const Image& b) {
     return a.width == b.width && a.height == b.height &&
@@ -73,8 +76,8 @@ TEST(Schedule, EveryPixelIsWrittenOnce) {
     }
 }
 
-// Each worker's load names the packets that worker traced, and its busy time covers the time they
-// took (each packet here takes at least 200 microseconds).
+// Each worker's load names the packets that worker traced, its busy time covers the time they took
+// (each packet here takes at least 200 microseconds), and its start and finish enclose them.
 TEST(Schedule, ReportsEachWorkersLoad) {
     const PacketGrid grid(40, 24, 8);
     Image image(40, 24);
@@ -85,6 +88,7 @@ TEST(Schedule, ReportsEachWorkersLoad) {
         o.dispatch = d;
         o.workers = kWorkers;
         std::vector<WorkerLoad> loads;
+        const Timer frame;
         ASSERT_TRUE(run_packets(
             grid, o, image,
             [&](unsigned w, const PixelRect&, std::span<Vec3>) {
@@ -93,11 +97,16 @@ TEST(Schedule, ReportsEachWorkersLoad) {
                 while (t.seconds() < 200e-6) {}
             },
             &loads));
+        const double frame_seconds = frame.seconds();
         ASSERT_EQ(loads.size(), kWorkers) << to_string(d);
         std::size_t packets = 0;
         for (unsigned w = 0; w < kWorkers; ++w) {
             EXPECT_EQ(loads[w].packets, traced[w].load()) << to_string(d) << " worker " << w;
             EXPECT_GE(loads[w].busy_seconds, 200e-6 * static_cast<double>(loads[w].packets)) << to_string(d);
+            // Its packets lie between its start and its finish, which lie inside the frame.
+            EXPECT_GE(loads[w].started_seconds, 0.0) << to_string(d);
+            EXPECT_LE(loads[w].started_seconds + loads[w].busy_seconds, loads[w].finished_seconds) << to_string(d);
+            EXPECT_LE(loads[w].finished_seconds, frame_seconds) << to_string(d);
             packets += loads[w].packets;
         }
         EXPECT_EQ(packets, grid.count()) << to_string(d);
@@ -128,37 +137,51 @@ TEST(Schedule, RejectsBadSettings) {
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
 }
 
-// The team behind both dispatch modes: every worker index runs once per run, all at the same time
-// (a job that waits for all the others would hang otherwise), worker w on the same thread from run
-// to run, the caller's `meanwhile` alongside, and a larger run after a smaller one grows the team.
-TEST(WorkerTeam, RunsEveryWorkerAtOnceOnKeptThreads) {
+// The team behind both dispatch modes: every job index runs once per run, all at the same time (a
+// job that waits for all the others would hang otherwise), job 0 on the calling thread and job j on
+// the same thread from run to run, and a larger run after a smaller one grows the team; whether the
+// threads were still polling after the last run or asleep.
+TEST(WorkerTeam, RunsEveryJobAtOnceOnKeptThreads) {
     detail::WorkerTeam team;
     std::vector<std::thread::id> first(4);
-    for (unsigned n : {4u, 2u, 4u, 6u}) {
+    using Run = std::pair<unsigned, std::chrono::microseconds>;
+    for (const auto& [n, spin] : {Run{4u, 0us}, Run{2u, 1000us}, Run{4u, 1000us}, Run{6u, 0us}, Run{1u, 0us}, Run{3u, 0us}}) {
         std::atomic<unsigned> arrived{0};
         std::mutex m;
         std::vector<std::thread::id> ids(n);
         std::set<std::thread::id> distinct;
-        bool meanwhile_ran = false;
-        team.run(
-            n, false,
-            [&](unsigned w) {
-                arrived.fetch_add(1);
-                while (arrived.load() < n) std::this_thread::yield();  // a barrier: needs all n at once
-                std::lock_guard lock(m);
-                ids[w] = std::this_thread::get_id();
-                distinct.insert(ids[w]);
-            },
-            [&] { meanwhile_ran = true; });
-        EXPECT_TRUE(meanwhile_ran);
+        team.run(n, false, spin, [&](unsigned j) {
+            arrived.fetch_add(1);
+            while (arrived.load() < n) std::this_thread::yield();  // a barrier: needs all n at once
+            std::lock_guard lock(m);
+            ids[j] = std::this_thread::get_id();
+            distinct.insert(ids[j]);
+        });
         EXPECT_EQ(arrived.load(), n);
         EXPECT_EQ(distinct.size(), n);
-        EXPECT_EQ(distinct.count(std::this_thread::get_id()), 0u);
-        for (unsigned w = 0; w < std::min(n, 4u); ++w) {
-            if (first[w] == std::thread::id{}) first[w] = ids[w];
-            EXPECT_EQ(ids[w], first[w]) << "worker " << w << " moved to another thread";
+        EXPECT_EQ(ids[0], std::this_thread::get_id());
+        for (unsigned j = 1; j < std::min(n, 4u); ++j) {
+            if (first[j] == std::thread::id{}) first[j] = ids[j];
+            EXPECT_EQ(ids[j], first[j]) << "job " << j << " moved to another thread";
         }
     }
+}
+
+// An exception from job 0 reaches the caller once the other jobs are done, and the team still runs.
+TEST(WorkerTeam, RethrowsJobZerosExceptionAfterTheOthers) {
+    detail::WorkerTeam team;
+    std::atomic<unsigned> others{0};
+    EXPECT_THROW(team.run(3, false, 0us,
+                          [&](unsigned j) {
+                              if (j == 0) throw Error("job 0 failed");
+                              const Timer t;
+                              while (t.seconds() < 1e-3) {}
+                              ++others;
+                          }),
+                 Error);
+    EXPECT_EQ(others.load(), 2u);
+    team.run(3, false, 0us, [&](unsigned) { ++others; });
+    EXPECT_EQ(others.load(), 5u);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@ struct RenderOptions {
     int packet = 16;       // packet edge P in pixels: a P x P packet is one batch for the accelerator
     Dispatch dispatch = Dispatch::pull;  // how packets reach the workers (schedule.hpp)
     bool pin = false;      // pin worker threads to cores
+    std::chrono::microseconds idle_spin = kDefaultIdleSpin;  // workers' poll before sleeping (schedule.hpp)
     bool count = false;    // collect traversal counters
     // Called now and then with (packets done, packets in all).
     std::function<void(std::size_t, std::size_t)> progress;

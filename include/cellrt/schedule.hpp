@@ -11,6 +11,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <span>
@@ -22,6 +23,8 @@
 namespace cellrt {
 
 enum class Dispatch { pull, mailbox };
+
+inline constexpr std::chrono::microseconds kDefaultIdleSpin{1000};
 
 Dispatch parse_dispatch(const std::string& name);  // "pull" | "mailbox"; throws cellrt::Error
 const char* to_string(Dispatch d);
@@ -53,7 +56,12 @@ void packet_order(const PixelRect& rect, std::vector<std::uint32_t>& order);
 struct ScheduleOptions {
     Dispatch dispatch = Dispatch::pull;
     unsigned workers = 0;  // 0: all hardware threads
-    bool pin = false;      // pin worker i to core i (Linux; ignored where unavailable)
+    // Pin worker i to core i (under mailbox dispatch the master to core 0 and worker i to core i + 1;
+    // Linux; ignored where unavailable). Worker 0 (pull) or the master (mailbox) is the calling thread.
+    bool pin = false;
+    // After the frame the workers poll for the next one this long before they sleep, so that frames
+    // drawn back to back do not pay a wake-up per worker (0: sleep at once; docs/SCALING.md).
+    std::chrono::microseconds idle_spin{kDefaultIdleSpin};
     const std::atomic<bool>* cancel = nullptr;
     std::function<void(std::size_t, std::size_t)> progress;  // (packets done, packets in all)
 };
@@ -62,11 +70,15 @@ struct ScheduleOptions {
 using PacketTracer = std::function<void(unsigned worker, const PixelRect& rect, std::span<Vec3> colours)>;
 
 // What one worker did in a frame: the packets it traced and the time it spent tracing them (its
-// PacketTracer calls and, under pull dispatch, writing their colours). A frame of N workers that
-// takes T seconds leaves N * T - sum(busy) to the schedule itself: waking, claiming, waiting.
+// PacketTracer calls and, under pull dispatch, writing their colours), and when it started and
+// finished, counted from the start of the frame. A frame of N workers that takes T seconds leaves
+// N * T - sum(busy) to the schedule itself: waking the workers (sum(started)), claiming packets
+// between them, and waiting for the last one (sum(T - finished)).
 struct WorkerLoad {
     std::size_t packets = 0;
     double busy_seconds = 0.0;
+    double started_seconds = 0.0;   // when the worker woke and began to claim packets
+    double finished_seconds = 0.0;  // when it found no packet left (or the frame cancelled)
 };
 
 // Number of worker threads `options` asks for.

@@ -128,6 +128,7 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     schedule.dispatch = options.dispatch;
     schedule.workers = options.threads;
     schedule.pin = options.pin;
+    schedule.idle_spin = options.idle_spin;
     schedule.cancel = options.cancel;
     schedule.progress = options.progress;
     std::vector<PacketWork> work(worker_count(schedule));

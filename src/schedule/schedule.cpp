@@ -33,30 +33,35 @@ void timed(WorkerLoad& load, TracePacket&& trace_packet) {
 }
 
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
-              std::vector<PaddedLoad>& loads) {
+              const Timer& frame, std::vector<PaddedLoad>& loads) {
     const auto workers = static_cast<unsigned>(loads.size());
-    // Apart, so that claiming a packet and reporting one do not contend for one cache line.
+    // Apart, so that claiming a packet and reporting one do not contend for one cache line; `done` is
+    // touched only for a progress callback (each worker counts its own packets in its load).
     alignas(64) std::atomic<std::size_t> next{0};
     alignas(64) std::atomic<std::size_t> done{0};
     // Allocated here: a worker that allocates gets a malloc arena of its own, on every frame.
     std::vector<std::vector<Vec3>> buffers(workers, std::vector<Vec3>(static_cast<std::size_t>(grid.packet) * grid.packet));
     auto work = [&](unsigned w) {
+        WorkerLoad& load = loads[w].load;
+        load.started_seconds = frame.seconds();
         std::vector<Vec3>& colours = buffers[w];
         for (std::size_t p = next.fetch_add(1, std::memory_order_relaxed); p < grid.count();
              p = next.fetch_add(1, std::memory_order_relaxed)) {
-            if (cancelled(options)) return;
+            if (cancelled(options)) break;
             const PixelRect r = grid.rect(p);
             const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
-            timed(loads[w].load, [&] {
+            timed(load, [&] {
                 trace(w, r, out);
                 store(image, r, out);
             });
-            const std::size_t finished = done.fetch_add(1, std::memory_order_relaxed) + 1;
-            if (options.progress) options.progress(finished, grid.count());
+            if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, grid.count());
         }
+        load.finished_seconds = frame.seconds();
     };
-    detail::worker_team().run(workers, options.pin, work);
-    return done.load() == grid.count();
+    detail::worker_team().run(workers, options.pin, options.idle_spin, work);
+    std::size_t traced = 0;
+    for (const PaddedLoad& l : loads) traced += l.load.packets;
+    return traced == grid.count();
 }
 
 // One worker's single-slot mailbox, after the Cell's SPU mailboxes: a slot the master writes a packet
@@ -77,22 +82,25 @@ void poll(Ready&& ready) {
 }
 
 bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
-                 std::vector<PaddedLoad>& loads) {
+                 const Timer& frame, std::vector<PaddedLoad>& loads) {
     const auto workers = static_cast<unsigned>(loads.size());
     std::vector<Mailbox> boxes(workers);
     for (Mailbox& b : boxes) b.colours.resize(static_cast<std::size_t>(grid.packet) * grid.packet);
 
     auto work = [&](unsigned w) {
         Mailbox& box = boxes[w];
+        WorkerLoad& load = loads[w].load;
+        load.started_seconds = frame.seconds();
         for (;;) {
             int s;
             poll([&] { return (s = box.state.load(std::memory_order_acquire)) == Mailbox::work || s == Mailbox::stop; });
-            if (s == Mailbox::stop) return;
-            timed(loads[w].load, [&] {
+            if (s == Mailbox::stop) break;
+            timed(load, [&] {
                 trace(w, box.rect, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
             });
             box.state.store(Mailbox::done, std::memory_order_release);
         }
+        load.finished_seconds = frame.seconds();
     };
     // The master (the study's PPU), on the calling thread: keeps the packet counter, posts each packet
     // to an idle worker, and writes every finished packet's colours into the frame buffer.
@@ -123,7 +131,12 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
         }
         for (Mailbox& b : boxes) b.state.store(Mailbox::stop, std::memory_order_release);
     };
-    detail::worker_team().run(workers, options.pin, work, master);
+    // Job 0 (the calling thread) is the master, job i + 1 worker i: the master has a core of its own
+    // when there are cores to spare, as the PPU was a core of its own.
+    detail::worker_team().run(workers + 1, options.pin, options.idle_spin, [&](unsigned j) {
+        if (j == 0) master();
+        else work(j - 1);
+    });
     return done == grid.count();
 }
 
@@ -174,8 +187,9 @@ bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& 
                  std::vector<WorkerLoad>* loads) {
     if (image.width != grid.width || image.height != grid.height) throw Error("frame buffer does not match the packet grid");
     std::vector<PaddedLoad> padded(worker_count(options));
-    const bool complete = options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, padded)
-                                                             : run_mailbox(grid, options, image, trace, padded);
+    const Timer frame;
+    const bool complete = options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, frame, padded)
+                                                             : run_mailbox(grid, options, image, trace, frame, padded);
     if (loads) {
         loads->clear();
         for (const PaddedLoad& p : padded) loads->push_back(p.load);

@@ -6,9 +6,17 @@
 // of rays there. Measured on the 2-core development machine: about 0.2 ms per two-thread frame for
 // the starts and 0.4 ms more for 128 KiB of stack, a fixed cost that was up to a tenth of a 512 x 512
 // frame (docs/SCALING.md). A team starts its threads once and wakes them for every run.
+//
+// Waking a sleeping thread costs more again: the kernel's wake-up, and in a virtual machine the host
+// scheduling the halted virtual core back in (tens to hundreds of microseconds per thread on the
+// 16-core machine of docs/SCALING.md). So after a run the threads poll for the next one for a while
+// (`spin`) before they sleep, as OpenMP runtimes and TBB's workers do, and frames drawn back to back
+// find the team awake. The calling thread is job 0, as OpenMP's master thread is thread 0: N jobs
+// take N threads, not N + 1 on N cores, and one wake-up fewer.
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -24,16 +32,17 @@ public:
     WorkerTeam& operator=(const WorkerTeam&) = delete;
     ~WorkerTeam();
 
-    // Runs job(w) for every w in [0, n) at once, on n threads of the team (worker w is always the same
-    // thread; pinned to core w when `pin`, free to run anywhere otherwise), and returns when every
-    // call has returned. The team grows to n threads on first need. One run at a time: a second
-    // caller waits for the first; a job must not call run() itself. The calling thread runs
-    // `meanwhile` (when given) while the workers run: the mailbox dispatch's master.
-    void run(unsigned n, bool pin, const std::function<void(unsigned)>& job,
-             const std::function<void()>& meanwhile = {});
+    // Runs job(j) for every j in [0, n) at once and returns when every call has returned: job 0 on
+    // the calling thread, job j > 0 on thread j - 1 of the team (always the same thread; the team
+    // grows to n - 1 threads on first need). With `pin`, job j runs on core j (the caller's own
+    // affinity is restored afterwards); otherwise anywhere. After the run the team's threads poll for
+    // the next one for `spin` before they sleep (0: sleep at once). One run at a time: a second
+    // caller waits for the first; a job must not call run() itself. An exception from job 0 is
+    // rethrown once the other jobs have returned.
+    void run(unsigned n, bool pin, std::chrono::microseconds spin, const std::function<void(unsigned)>& job);
 
 private:
-    void loop(unsigned w, std::uint64_t seen);
+    void loop(unsigned t, std::uint64_t seen);
     void set_affinity(bool pin);
 
     std::mutex run_mutex_;
@@ -41,8 +50,9 @@ private:
     bool pinned_ = false;
     // The current run, written by run() before `generation_` is bumped, read by the threads after.
     const std::function<void(unsigned)>* job_ = nullptr;
-    unsigned active_ = 0;
+    unsigned jobs_ = 0;
     bool stopping_ = false;
+    std::atomic<std::int64_t> spin_microseconds_{0};  // read by threads that may still be in the last run
     std::atomic<std::uint64_t> generation_{0};
     std::atomic<unsigned> remaining_{0};  // threads that have not yet finished the current run
 };
