@@ -50,8 +50,11 @@ def main() -> int:
                      ylim=(0, 1.15))
             for ax in (ax_t, ax_e):
                 ax.set_xticks(sorted({x for pts in by_dispatch[d].values() for x, _ in pts}))
-        handles, labels = axes[0][0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="center right", fontsize=7)
+        legend = {}  # every curve of every row, once
+        for ax in axes.flat:
+            for handle, label in zip(*ax.get_legend_handles_labels()):
+                legend.setdefault(label, handle)
+        fig.legend(list(legend.values()), list(legend), loc="center right", fontsize=7)
         fig.tight_layout(rect=(0, 0, 0.8, 1))
         out = os.path.join(sys.argv[2], f"scaling_{scene}.png")
         fig.savefig(out, dpi=100)

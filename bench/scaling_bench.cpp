@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
     std::string size = "512x512";
     std::string csv_path, json_path;
     int idle_spin = static_cast<int>(kDefaultIdleSpin.count());
+    bool pin = false;
     app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
     app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
     app.add_option("--idle-spin-us", idle_spin, "Microseconds the workers poll for the next frame before sleeping")
         ->capture_default_str()
         ->check(CLI::Range(0, 1000000));
+    app.add_flag("--pin", pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     app.add_option("--csv", csv_path, "Write every point as CSV");
     app.add_option("--json", json_path, "Write every point as JSON");
     CLI11_PARSE(app, argc, argv);
@@ -101,6 +103,7 @@ int main(int argc, char** argv) {
                             o.packet = p;
                             o.dispatch = parse_dispatch(d);
                             o.idle_spin = std::chrono::microseconds(idle_spin);
+                            o.pin = pin;
                             return o;
                         };
                         Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
