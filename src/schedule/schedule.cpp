@@ -32,9 +32,6 @@ void timed(WorkerLoad& load, TracePacket&& trace_packet) {
     ++load.packets;
 }
 
-// Packets a worker claims at once while many are left (run_pull).
-constexpr std::size_t kClaimRun = 4;
-
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
               const Timer& frame, std::vector<PaddedLoad>& loads) {
     const auto workers = static_cast<unsigned>(loads.size());
@@ -44,30 +41,20 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
     alignas(64) std::atomic<std::size_t> done{0};
     // Allocated here: a worker that allocates gets a malloc arena of its own, on every frame.
     std::vector<std::vector<Vec3>> buffers(workers, std::vector<Vec3>(static_cast<std::size_t>(grid.packet) * grid.packet));
-    // Packets are claimed kClaimRun neighbours of a row at a time while many are left, then one at a
-    // time (guided self-scheduling): the claim counter's cache line crosses between cores once per
-    // run instead of once per packet, and single claims near the end keep the wait for the last
-    // worker to one packet. Measured (docs/SCALING.md): the time between packets at 2 workers fell
-    // from 0.4-1.6% to 0.1-0.8% of a frame; at 16 no change beyond the machine's noise.
-    const std::size_t count = grid.count();
-    const std::size_t single_from = count - std::min<std::size_t>(count, std::size_t{4} * kClaimRun * workers);
     auto work = [&](unsigned w) {
         WorkerLoad& load = loads[w].load;
         load.started_seconds = frame.seconds();
         std::vector<Vec3>& colours = buffers[w];
-        for (std::size_t claimed = 0; !cancelled(options);) {
-            const std::size_t run = claimed < single_from ? kClaimRun : 1;
-            claimed = next.fetch_add(run, std::memory_order_relaxed);
-            if (claimed >= count) break;
-            for (std::size_t p = claimed; p < std::min(claimed + run, count); ++p) {
-                const PixelRect r = grid.rect(p);
-                const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
-                timed(load, [&] {
-                    trace(w, r, out);
-                    store(image, r, out);
-                });
-                if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, count);
-            }
+        for (std::size_t p = next.fetch_add(1, std::memory_order_relaxed); p < grid.count();
+             p = next.fetch_add(1, std::memory_order_relaxed)) {
+            if (cancelled(options)) break;
+            const PixelRect r = grid.rect(p);
+            const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
+            timed(load, [&] {
+                trace(w, r, out);
+                store(image, r, out);
+            });
+            if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, grid.count());
         }
         load.finished_seconds = frame.seconds();
     };
