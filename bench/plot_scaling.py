@@ -2,7 +2,9 @@
 """Draws the scaling curves of cellrt_scaling's JSON: per scene, seconds per frame and parallel
 efficiency against workers, one row per dispatch mode; colour = structure, line style = packet size.
 
-usage: bench/plot_scaling.py scaling.json OUTDIR     (Debian's python3, with python3-matplotlib)
+usage: bench/plot_scaling.py scaling.json [more.json ...] OUTDIR   (Debian's python3, python3-matplotlib)
+
+Several runs are drawn together; a point that more than one of them measured is taken from the first.
 """
 import json
 import os
@@ -18,16 +20,22 @@ STYLES = ["-", "--", ":", "-."]
 
 
 def main() -> int:
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3:
         print(__doc__, file=sys.stderr)
         return 2
-    with open(sys.argv[1], encoding="utf-8") as f:
-        points = json.load(f)
-    os.makedirs(sys.argv[2], exist_ok=True)
+    *inputs, outdir = sys.argv[1:]
+    seen = set()
     # scene -> dispatch -> (config, packet) -> [(workers, seconds)]
     data = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))
-    for p in points:
-        data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append((p["workers"], p["seconds"]))
+    for path in inputs:
+        with open(path, encoding="utf-8") as f:
+            for p in json.load(f):
+                key = (p["scene"], p["dispatch"], p["config"], p["packet"], p["workers"])
+                if key in seen:
+                    continue
+                seen.add(key)
+                data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append((p["workers"], p["seconds"]))
+    os.makedirs(outdir, exist_ok=True)
     for scene, by_dispatch in data.items():
         dispatches = sorted(by_dispatch)
         configs = sorted({c for d in by_dispatch.values() for c, _ in d})
@@ -56,7 +64,7 @@ def main() -> int:
                 legend.setdefault(label, handle)
         fig.legend(list(legend.values()), list(legend), loc="center right", fontsize=7)
         fig.tight_layout(rect=(0, 0, 0.8, 1))
-        out = os.path.join(sys.argv[2], f"scaling_{scene}.png")
+        out = os.path.join(outdir, f"scaling_{scene}.png")
         fig.savefig(out, dpi=100)
         plt.close(fig)
         print(out)

@@ -1,0 +1,48 @@
+# The scaling study end to end, on a small scene: cellrt_scaling's tables and JSON for both dispatch
+# modes at 1 and 2 workers, then bench/scaling_tables.py and bench/plot_scaling.py on that JSON, as
+# docs/SCALING.md runs them. Arguments: SCALING (the program), PYTHON, SOURCE, WORK.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+execute_process(
+  COMMAND ${SCALING} --scenes builtin:city?tris=3000 --configs kd+auto bih:branched --dispatch pull mailbox
+          --packets 8 --workers 1 2 --repeats 1 --size 40x24 --json ${WORK}/scaling.json --csv ${WORK}/scaling.csv
+  OUTPUT_VARIABLE tables ERROR_VARIABLE log RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "cellrt_scaling failed (${rc}): ${log}")
+endif()
+foreach(expected "### kd+auto, mailbox dispatch, 8x8 packets" "Where the 2 workers' time went" "| city |")
+  string(FIND "${tables}" "${expected}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "cellrt_scaling's tables lack '${expected}':\n${tables}")
+  endif()
+endforeach()
+
+# Every point: 2 configurations x 2 dispatch modes x 2 worker counts, each with its schedule's account.
+file(READ ${WORK}/scaling.json json)
+string(JSON points LENGTH "${json}")
+if(NOT points EQUAL 8)
+  message(FATAL_ERROR "expected 8 points, found ${points}")
+endif()
+math(EXPR last "${points} - 1")
+foreach(i RANGE ${last})
+  string(JSON seconds GET "${json}" ${i} seconds)
+  string(JSON busy GET "${json}" ${i} busy_seconds)
+  string(JSON started GET "${json}" ${i} started_seconds)
+  string(JSON waiting GET "${json}" ${i} waiting_seconds)
+  string(JSON rays GET "${json}" ${i} rays)
+  if(NOT seconds GREATER 0 OR NOT busy GREATER 0 OR started LESS 0 OR waiting LESS 0 OR NOT rays GREATER 960)
+    message(FATAL_ERROR "point ${i} is implausible: ${seconds} s, busy ${busy}, started ${started}, waiting ${waiting}, ${rays} rays")
+  endif()
+endforeach()
+
+execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/scaling_tables.py ${WORK}/scaling.json
+                OUTPUT_VARIABLE table ERROR_VARIABLE log RESULT_VARIABLE rc)
+string(FIND "${table}" "| city |" at)
+if(NOT rc EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "bench/scaling_tables.py failed (${rc}): ${log}${table}")
+endif()
+execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/plot_scaling.py ${WORK}/scaling.json ${WORK}/plots
+                ERROR_VARIABLE log RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/plots/scaling_city.png)
+  message(FATAL_ERROR "bench/plot_scaling.py failed (${rc}), needs python3-matplotlib: ${log}")
+endif()
