@@ -14,7 +14,7 @@ namespace {
 
 // Waits until `value` no longer holds `old` and returns what it holds then: polls for up to `spin`
 // (yielding between polls, so that a machine with more threads than cores still makes progress),
-// then sleeps in the kernel until notified.
+// then sleeps in the kernel (atomic::wait returns only once the value differs from `old`).
 template <class T>
 T wait_for_change(const std::atomic<T>& value, T old, std::chrono::microseconds spin) {
     const auto until = std::chrono::steady_clock::now() + spin;
@@ -24,10 +24,8 @@ T wait_for_change(const std::atomic<T>& value, T old, std::chrono::microseconds 
         if (std::chrono::steady_clock::now() >= until) break;
         std::this_thread::yield();
     }
-    for (T now = value.load(std::memory_order_acquire);; now = value.load(std::memory_order_acquire)) {
-        if (now != old) return now;
-        value.wait(old, std::memory_order_acquire);
-    }
+    value.wait(old, std::memory_order_acquire);
+    return value.load(std::memory_order_acquire);
 }
 
 }  // namespace
