@@ -34,8 +34,10 @@ WorkerTeam::~WorkerTeam() {
     {
         std::lock_guard lock(run_mutex_);
         stopping_ = true;
-        generation_.fetch_add(1, std::memory_order_release);
-        generation_.notify_all();
+        for (const auto& s : signals_) {
+            s->generation.fetch_add(1, std::memory_order_release);
+            s->generation.notify_one();
+        }
     }
     for (std::thread& t : threads_) t.join();
 }
@@ -43,10 +45,11 @@ WorkerTeam::~WorkerTeam() {
 void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const std::function<void(unsigned)>& job) {
     std::lock_guard lock(run_mutex_);
     while (threads_.size() + 1 < n) {
-        // A new thread waits for the next generation, not for any that came before it.
+        // A new thread's signal starts at 0 and the thread waits for it to change: the first run it
+        // takes part in is the first bump, whether that comes before or after the thread starts.
         const auto t = static_cast<unsigned>(threads_.size());
-        const std::uint64_t now = generation_.load(std::memory_order_relaxed);
-        threads_.emplace_back([this, t, now] { loop(t, now); });
+        Signal& signal = *signals_.emplace_back(std::make_unique<Signal>());
+        threads_.emplace_back([this, t, &signal] { loop(t, signal); });
     }
     set_affinity(pin);
 #ifdef __linux__
@@ -60,13 +63,15 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
     }
 #endif
     job_ = &job;
-    jobs_ = n;
     spin_microseconds_.store(spin.count(), std::memory_order_relaxed);
-    // Every thread of the team takes part in every run (those beyond n - 1 only report back), so that
-    // no thread can still be reading this run's job when the next run writes its own.
-    remaining_.store(static_cast<unsigned>(threads_.size()), std::memory_order_relaxed);
-    generation_.fetch_add(1, std::memory_order_release);
-    generation_.notify_all();
+    // Only the threads this run needs are woken; each reads job_ before it reports back, and run()
+    // returns only after all of them have, so no thread reads a job_ that a later run has replaced.
+    const unsigned helpers = n > 0 ? n - 1 : 0;
+    remaining_.store(helpers, std::memory_order_relaxed);
+    for (unsigned t = 0; t < helpers; ++t) {
+        signals_[t]->generation.fetch_add(1, std::memory_order_release);
+        signals_[t]->generation.notify_one();
+    }
     std::exception_ptr failure;
     try {
         if (n > 0) job(0);
@@ -82,12 +87,13 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
     if (failure) std::rethrow_exception(failure);
 }
 
-void WorkerTeam::loop(unsigned t, std::uint64_t seen) {
+void WorkerTeam::loop(unsigned t, Signal& signal) {
     // A thread's first wait sleeps at once: a new team has run nothing yet.
+    std::uint64_t seen = 0;
     for (std::chrono::microseconds spin{0};;) {
-        seen = wait_for_change(generation_, seen, spin);
+        seen = wait_for_change(signal.generation, seen, spin);
         if (stopping_) return;
-        if (t + 1 < jobs_) (*job_)(t + 1);
+        (*job_)(t + 1);
         spin = std::chrono::microseconds(spin_microseconds_.load(std::memory_order_relaxed));
         if (remaining_.fetch_sub(1, std::memory_order_acq_rel) == 1) remaining_.notify_one();
     }
