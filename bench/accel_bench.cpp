@@ -42,6 +42,7 @@ FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
     std::vector<std::uint32_t> order;
     for (std::size_t p = 0; p < grid.count(); ++p) {
         const PixelRect r = grid.rect(p);
+        order.resize(static_cast<std::size_t>(r.pixels()));
         packet_order(r, order);
         for (const std::uint32_t o : order)
             f.primary.push_back(camera.primary(r.x0 + static_cast<int>(o) % r.width(), r.y0 + static_cast<int>(o) / r.width()));

@@ -113,6 +113,53 @@ TEST(Schedule, ReportsEachWorkersLoad) {
     }
 }
 
+// Pull dispatch starts worker w on the w-th run of packets; here the first worker's run is slow (each
+// packet 5 ms, the rest free), so the others must take its packets from it, one at a time at the end,
+// and every packet is still traced exactly once.
+TEST(Schedule, PullWorkersTakePacketsFromTheBusiest) {
+    const PacketGrid grid(48, 40, 4);  // 120 packets: worker 0 starts with packets 0..29 of 4 workers
+    Image image(48, 40);
+    constexpr unsigned kWorkers = 4;
+    std::vector<std::atomic<int>> traced(grid.count());
+    std::vector<std::atomic<unsigned>> by(grid.count());
+    ScheduleOptions o;
+    o.workers = kWorkers;
+    ASSERT_TRUE(run_packets(grid, o, image, [&](unsigned w, const PixelRect& r, std::span<Vec3>) {
+        const std::size_t p = static_cast<std::size_t>(r.y0 / 4) * grid.columns() + static_cast<std::size_t>(r.x0 / 4);
+        ++traced[p];
+        by[p] = w;
+        if (p < grid.count() / kWorkers) {
+            const Timer t;
+            while (t.seconds() < 5e-3) {}
+        }
+    }));
+    std::set<unsigned> slow_run_workers;
+    for (std::size_t p = 0; p < grid.count(); ++p) {
+        EXPECT_EQ(traced[p].load(), 1) << "packet " << p;
+        if (p < grid.count() / kWorkers) slow_run_workers.insert(by[p].load());
+    }
+    EXPECT_GE(slow_run_workers.size(), 2u) << "nobody took packets from the busy worker";
+}
+
+// Many workers on few cores, packets of one pixel, frame after frame: no packet lost or traced twice
+// while workers race to take the last packets from each other.
+TEST(Schedule, PullTracesEveryPacketOnceWhileWorkersRace) {
+    const PacketGrid grid(31, 23, 1);
+    Image image(31, 23);
+    std::vector<std::atomic<int>> traced(grid.count());
+    for (unsigned workers : {2u, 5u, 8u, 13u}) {
+        for (int frame = 0; frame < 20; ++frame) {
+            for (auto& t : traced) t = 0;
+            ScheduleOptions o;
+            o.workers = workers;
+            ASSERT_TRUE(run_packets(grid, o, image, [&](unsigned, const PixelRect& r, std::span<Vec3>) {
+                ++traced[static_cast<std::size_t>(r.y0) * 31 + static_cast<std::size_t>(r.x0)];
+            }));
+            for (std::size_t p = 0; p < grid.count(); ++p) ASSERT_EQ(traced[p].load(), 1) << workers << " workers, packet " << p;
+        }
+    }
+}
+
 TEST(Schedule, CancellationStopsEarlyAndReportsIt) {
     const PacketGrid grid(64, 64, 2);
     Image image(64, 64);
@@ -135,17 +182,20 @@ TEST(Schedule, RejectsBadSettings) {
     EXPECT_THROW(PacketGrid(16, 16, 0), Error);
     EXPECT_THROW(parse_dispatch("push"), Error);
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
+    std::vector<std::uint32_t> order(15);
+    EXPECT_THROW(packet_order(PixelRect{0, 0, 4, 4}, order), Error);
 }
 
 // The team behind both dispatch modes: every job index runs once per run, all at the same time (a
 // job that waits for all the others would hang otherwise), job 0 on the calling thread and job j on
 // the same thread from run to run, and a larger run after a smaller one grows the team; whether the
-// threads were still polling after the last run or asleep.
+// threads were still polling after the last run, asleep, or left out of the runs in between.
 TEST(WorkerTeam, RunsEveryJobAtOnceOnKeptThreads) {
     detail::WorkerTeam team;
     std::vector<std::thread::id> first(4);
     using Run = std::pair<unsigned, std::chrono::microseconds>;
-    for (const auto& [n, spin] : {Run{4u, 0us}, Run{2u, 1000us}, Run{4u, 1000us}, Run{6u, 0us}, Run{1u, 0us}, Run{3u, 0us}}) {
+    for (const auto& [n, spin] : {Run{4u, 0us}, Run{2u, 1000us}, Run{4u, 1000us}, Run{6u, 0us}, Run{1u, 0us}, Run{3u, 0us},
+                                  Run{6u, 1000us}, Run{1u, 1000us}, Run{1u, 0us}, Run{6u, 0us}}) {
         std::atomic<unsigned> arrived{0};
         std::mutex m;
         std::vector<std::thread::id> ids(n);

@@ -5,8 +5,9 @@
 //   to an idle worker through that worker's single-slot mailbox, waits for the worker's colours and
 //   writes them into the frame buffer. Every packet passes through the master twice, which is why the
 //   study saw no scaling past two workers with 2 x 2 packets.
-// - pull: workers claim packets from a shared atomic counter and write the frame buffer themselves;
-//   nothing is serialised but the counter.
+// - pull: each worker starts on a contiguous run of packets, claims them one by one and writes the
+//   frame buffer itself; a worker whose run is done takes half of the longest run left (work
+//   stealing). Nothing passes through a master, and claims do not contend.
 // Both give the same image: a pixel's colour depends only on its own rays.
 #pragma once
 
@@ -49,9 +50,10 @@ struct PacketGrid {
 };
 
 // The pixels of a packet in the order its rays are traced: Morton (Z) order, so that any 4, 8 or 16
-// consecutive rays (one SIMD packet) cover a compact 2 x 2, 4 x 2 or 4 x 4 block. `order` receives
-// offsets y * rect.width() + x within the rect.
-void packet_order(const PixelRect& rect, std::vector<std::uint32_t>& order);
+// consecutive rays (one SIMD packet) cover a compact 2 x 2, 4 x 2 or 4 x 4 block. `order` (of
+// rect.pixels() entries; throws cellrt::Error otherwise) receives offsets y * rect.width() + x within
+// the rect.
+void packet_order(const PixelRect& rect, std::span<std::uint32_t> order);
 
 struct ScheduleOptions {
     Dispatch dispatch = Dispatch::pull;

@@ -6,6 +6,7 @@
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
+#include "schedule/cache_line.hpp"
 
 namespace cellrt {
 namespace {
@@ -18,15 +19,15 @@ Vec3 sky(const Vec3& dir) {
     return Vec3{0.9f, 0.95f, 1.f} * (1.f - k) + Vec3{0.35f, 0.55f, 0.9f} * k;
 }
 
-// Buffers of one worker, allocated once per render, reused for every packet. On a cache line of its
-// own: workers update their vectors' ends and counters on every packet.
+// Buffers of one worker, allocated once per render, reused for every packet. On cache lines of their
+// own: workers update their vectors' ends and counters and write the buffers on every packet.
 struct alignas(64) PacketWork {
-    std::vector<Ray> rays, shadow_rays;
-    std::vector<Hit> hits;
-    std::vector<std::uint8_t> occluded;
-    std::vector<Vec3> normals;
-    std::vector<std::uint32_t> shadow_pixel;
-    std::vector<std::uint32_t> order;  // order[i]: the pixel (offset in the packet) of ray i
+    CacheLineVector<Ray> rays, shadow_rays;
+    CacheLineVector<Hit> hits;
+    CacheLineVector<std::uint8_t> occluded;
+    CacheLineVector<Vec3> normals;
+    CacheLineVector<std::uint32_t> shadow_pixel;
+    CacheLineVector<std::uint32_t> order;  // order[i]: the pixel (offset in the packet) of ray i
     int order_width = 0, order_height = 0;  // the packet shape `order` was made for
     TraversalCounters primary, shadow;
     std::uint64_t shadow_ray_count = 0;
@@ -46,6 +47,7 @@ struct alignas(64) PacketWork {
 void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCamera& camera, const PixelRect& rect,
                   bool count, PacketWork& w, std::span<Vec3> colours) {
     if (rect.width() != w.order_width || rect.height() != w.order_height) {  // only edge packets differ
+        w.order.resize(static_cast<std::size_t>(rect.pixels()));
         packet_order(rect, w.order);
         w.order_width = rect.width();
         w.order_height = rect.height();
