@@ -5,6 +5,8 @@ efficiency against workers, one row per dispatch mode; colour = structure, line 
 usage: bench/plot_scaling.py scaling.json [more.json ...] OUTDIR   (Debian's python3, python3-matplotlib)
 
 Several runs are drawn together; a point that more than one of them measured is taken from the first.
+The efficiency is the JSON's own (the median of each round's ratio to the fewest workers) where it has
+one, else t(first) first / (t(N) N) from the medians.
 """
 import json
 import os
@@ -25,7 +27,7 @@ def main() -> int:
         return 2
     *inputs, outdir = sys.argv[1:]
     seen = set()
-    # scene -> dispatch -> (config, packet) -> [(workers, seconds)]
+    # scene -> dispatch -> (config, packet) -> [(workers, seconds, efficiency or None)]
     data = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))
     for path in inputs:
         with open(path, encoding="utf-8") as f:
@@ -34,7 +36,8 @@ def main() -> int:
                 if key in seen:
                     continue
                 seen.add(key)
-                data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append((p["workers"], p["seconds"]))
+                data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append(
+                    (p["workers"], p["seconds"], p.get("efficiency")))
     os.makedirs(outdir, exist_ok=True)
     for scene, by_dispatch in data.items():
         dispatches = sorted(by_dispatch)
@@ -46,18 +49,18 @@ def main() -> int:
         for row, d in enumerate(dispatches):
             ax_t, ax_e = axes[row]
             for (config, packet), pts in sorted(by_dispatch[d].items()):
-                pts.sort()
-                w = [x for x, _ in pts]
-                t = [y for _, y in pts]
+                pts.sort(key=lambda x: x[0])
+                w = [x for x, _, _ in pts]
+                t = [y for _, y, _ in pts]
                 label = f"{config} {packet}x{packet}"
                 kw = dict(color=colour[config], linestyle=style[packet], marker="o", label=label)
                 ax_t.plot(w, t, **kw)
-                ax_e.plot(w, [t[0] * w[0] / (ti * wi) for wi, ti in pts], **kw)
+                ax_e.plot(w, [e if e is not None else t[0] * w[0] / (ti * wi) for wi, ti, e in pts], **kw)
             ax_t.set(xlabel="workers", ylabel="seconds per frame", title=f"{scene}, {d}: time", yscale="log")
             ax_e.set(xlabel="workers", ylabel="parallel efficiency", title=f"{scene}, {d}: efficiency",
                      ylim=(0, 1.15))
             for ax in (ax_t, ax_e):
-                ax.set_xticks(sorted({x for pts in by_dispatch[d].values() for x, _ in pts}))
+                ax.set_xticks(sorted({x for pts in by_dispatch[d].values() for x, _, _ in pts}))
         legend = {}  # every curve of every row, once
         for ax in axes.flat:
             for handle, label in zip(*ax.get_legend_handles_labels()):

@@ -1,7 +1,8 @@
 // The study's scaling measurement (its Tables 5-1 and 5-2), with Embree alongside: seconds per frame
 // (512 x 512, primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode
 // and packet size. Every point is a warm-up frame and the median of --repeats frames, each timed
-// frame the second of two drawn back to back, the worker counts interleaved pair by pair; every table
+// frame the second of two drawn back to back, the worker counts interleaved round by round (the
+// efficiency and the packet time ratio are medians of each round's own ratios); every table
 // shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
 // and packet size, measured in the same run. Where the efficiency goes is split: the share of the
 // workers' time spent tracing and what the schedule took of the rest (waking the workers, between
@@ -38,8 +39,20 @@ struct Point {
     // Summed over workers, each the median over frames: time tracing packets, time from the frame's
     // start to each worker's start, time from each worker's finish to the frame's end.
     double busy_seconds, started_seconds, waiting_seconds;
+    // Against the fewest workers, the median over rounds of each round's ratio: a shared machine's
+    // speed drifts between rounds more than within one (its two frames are drawn back to back).
+    double efficiency;         // t(first) first / (t(N) N)
+    double packet_time_ratio;  // busy(N) / busy(first): how much longer the same packets took
     std::uint64_t rays;
 };
+
+// The median over rounds r of f(r).
+template <class F>
+double median_of_rounds(int rounds, F&& f) {
+    std::vector<double> v;
+    for (int r = 0; r < rounds; ++r) v.push_back(f(static_cast<std::size_t>(r)));
+    return median(v);
+}
 
 }  // namespace
 
@@ -74,6 +87,8 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     if (workers.empty())
         for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) workers.push_back(w);
+    std::sort(workers.begin(), workers.end());  // efficiencies are against the fewest
+    workers.erase(std::unique(workers.begin(), workers.end()), workers.end());
 
     std::vector<Point> points;
     std::vector<std::string> scene_names;
@@ -93,7 +108,7 @@ int main(int argc, char** argv) {
                 const auto accel = make_accelerator(scene.triangles, cfg);
                 for (const std::string& d : dispatches)
                     for (int p : packets) {
-                        // Worker counts are interleaved frame by frame, so that a machine whose speed
+                        // Worker counts are interleaved round by round, so that a machine whose speed
                         // drifts (shared hosts do) shifts every count alike and efficiencies hold.
                         auto options = [&](unsigned w) {
                             RenderOptions o;
@@ -128,9 +143,16 @@ int main(int argc, char** argv) {
                                 started[w].push_back(s);
                                 waiting[w].push_back(e);
                             }
+                        const unsigned first = workers.front();
                         for (unsigned w : workers) {
+                            const double efficiency = median_of_rounds(repeats, [&](std::size_t r) {
+                                return times[first][r] * first / (times[w][r] * w);
+                            });
+                            const double packet_time_ratio =
+                                median_of_rounds(repeats, [&](std::size_t r) { return busy[w][r] / busy[first][r]; });
                             points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), median(busy[w]),
-                                              median(started[w]), median(waiting[w]), st.primary_rays + st.shadow_rays});
+                                              median(started[w]), median(waiting[w]), efficiency, packet_time_ratio,
+                                              st.primary_rays + st.shadow_rays});
                             std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
                                          cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
                         }
@@ -171,9 +193,8 @@ int main(int argc, char** argv) {
                         else if (y) std::printf(" %.4f (%.2f×) |", pt->seconds, y->seconds / pt->seconds);
                         else std::printf(" %.4f |", pt->seconds);
                     }
-                    const Point* first = find(scene, config, d, p, one);
                     const Point* last = find(scene, config, d, p, most);
-                    if (first && last) std::printf(" %.2f |\n", first->seconds * one / (last->seconds * most));
+                    if (last) std::printf(" %.2f |\n", last->efficiency);
                     else std::printf(" – |\n");
                 }
                 // The workers' time at the most workers (most x seconds), in shares: tracing packets,
@@ -183,15 +204,13 @@ int main(int argc, char** argv) {
                             "|---|---|---|---|---|---|\n",
                             most, most, most, one);
                 for (const std::string& scene : scene_names) {
-                    const Point* first = find(scene, config, d, p, one);
                     const Point* last = find(scene, config, d, p, most);
-                    if (!first || !last) continue;
+                    if (!last) continue;
                     const double all = last->seconds * most;
                     const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
                                  waiting = last->waiting_seconds / all;
                     std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", scene.c_str(), tracing, waking,
-                                std::max(0.0, 1.0 - tracing - waking - waiting), waiting,
-                                last->busy_seconds / first->busy_seconds);
+                                std::max(0.0, 1.0 - tracing - waking - waiting), waiting, last->packet_time_ratio);
                 }
             }
 
@@ -200,7 +219,8 @@ int main(int argc, char** argv) {
         nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
                          {"packet", pt.packet}, {"workers", pt.workers}, {"seconds", pt.seconds},
                          {"busy_seconds", pt.busy_seconds}, {"started_seconds", pt.started_seconds},
-                         {"waiting_seconds", pt.waiting_seconds}, {"rays", pt.rays}};
+                         {"waiting_seconds", pt.waiting_seconds}, {"efficiency", pt.efficiency},
+                         {"packet_time_ratio", pt.packet_time_ratio}, {"rays", pt.rays}};
         if (const Point* y = yardstick.empty() ? nullptr : find(pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;
         out.push_back(j);
@@ -208,13 +228,13 @@ int main(int argc, char** argv) {
     if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
     if (!csv_path.empty()) {
         std::ofstream csv(csv_path);
-        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,rays,"
-               "embree_seconds\n";
+        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,efficiency,"
+               "packet_time_ratio,rays,embree_seconds\n";
         for (const auto& j : out)
             csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
                 << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
                 << ',' << j["busy_seconds"] << ',' << j["started_seconds"]
-                << ',' << j["waiting_seconds"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+                << ',' << j["waiting_seconds"] << ',' << j["efficiency"] << ',' << j["packet_time_ratio"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
     }
     return 0;
 }

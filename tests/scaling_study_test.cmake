@@ -30,8 +30,17 @@ foreach(i RANGE ${last})
   string(JSON started GET "${json}" ${i} started_seconds)
   string(JSON waiting GET "${json}" ${i} waiting_seconds)
   string(JSON rays GET "${json}" ${i} rays)
-  if(NOT seconds GREATER 0 OR NOT busy GREATER 0 OR started LESS 0 OR waiting LESS 0 OR NOT rays GREATER 960)
-    message(FATAL_ERROR "point ${i} is implausible: ${seconds} s, busy ${busy}, started ${started}, waiting ${waiting}, ${rays} rays")
+  string(JSON efficiency GET "${json}" ${i} efficiency)
+  string(JSON packet_time GET "${json}" ${i} packet_time_ratio)
+  string(JSON workers GET "${json}" ${i} workers)
+  if(NOT seconds GREATER 0 OR NOT busy GREATER 0 OR started LESS 0 OR waiting LESS 0 OR NOT rays GREATER 960
+     OR NOT efficiency GREATER 0 OR NOT packet_time GREATER 0)
+    message(FATAL_ERROR "point ${i} is implausible: ${seconds} s, busy ${busy}, started ${started}, waiting ${waiting}, "
+                        "${rays} rays, efficiency ${efficiency}, packet time ratio ${packet_time}")
+  endif()
+  # Against the fewest workers (1 here), a point of 1 worker is its own reference.
+  if(workers EQUAL 1 AND (NOT efficiency EQUAL 1 OR NOT packet_time EQUAL 1))
+    message(FATAL_ERROR "point ${i} (1 worker) has efficiency ${efficiency} and packet time ratio ${packet_time}, not 1")
   endif()
 endforeach()
 
