@@ -153,7 +153,7 @@ Runner add_render(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
-    cmd->add_option("--stats", o->stats, "Write the run's figures (and the local store's) as JSON to FILE");
+    cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE");
     return [o] {
         const LocalStoreConfig local_store = o->local_store.config(o->packet);
         Timer load_timer;
@@ -197,6 +197,15 @@ Runner add_render(CLI::App& app) {
                                 {"shadow_rays", rs.shadow_rays}, {"build_seconds", st.build_seconds},
                                 {"render_seconds", rs.seconds}, {"figures", nlohmann::json::object()}};
             for (const auto& [k, v] : st.figures) j["figures"][k] = v;
+            // Each worker's share of the frame (docs/SCALING.md): the packets it traced, the time it
+            // spent tracing them, and when it started and finished, from the frame's start.
+            j["dispatch"] = to_string(ro.dispatch);
+            j["workers"] = nlohmann::json::array();
+            for (const WorkerLoad& w : rs.workers)
+                j["workers"].push_back({{"packets", w.packets},
+                                        {"busy_seconds", w.busy_seconds},
+                                        {"started_seconds", w.started_seconds},
+                                        {"finished_seconds", w.finished_seconds}});
             if (modelled) j["local_store"] = local_store_json(*modelled);
             write_file_atomically(o->stats, j.dump(1) + "\n", o->overwrite);
         }

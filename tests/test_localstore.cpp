@@ -469,7 +469,7 @@ struct TempDir {
 };
 
 // `render --local-store` gives direct memory's image, prints the model's figures and writes them as
-// JSON with --stats.
+// JSON with --stats, with each worker's load.
 TEST(LocalStoreCli, RendersTheSameImageAndReportsTheModel) {
     TempDir dir;
     const std::string scene = "'builtin:spheres?tris=3000' --size 40x30 --threads 2 --packet 8 ";
@@ -491,6 +491,16 @@ TEST(LocalStoreCli, RendersTheSameImageAndReportsTheModel) {
               j.at("primary_rays").get<std::uint64_t>() + j.at("shadow_rays").get<std::uint64_t>());
     EXPECT_GT(ls.at("cycles").get<std::uint64_t>(), 0u);
     EXPECT_GT(ls.at("node_cache").at("prefetches").get<std::uint64_t>(), 0u);
+    // Both workers' loads: together they traced the 5 x 4 packets of 8 x 8 pixels.
+    ASSERT_EQ(j.at("workers").size(), 2u);
+    std::size_t packets = 0;
+    for (const nlohmann::json& w : j.at("workers")) {
+        packets += w.at("packets").get<std::size_t>();
+        EXPECT_LE(w.at("started_seconds").get<double>() + w.at("busy_seconds").get<double>(),
+                  w.at("finished_seconds").get<double>());
+    }
+    EXPECT_EQ(packets, 20u);
+    EXPECT_EQ(j.at("dispatch"), "pull");
     EXPECT_NE(run_cli(dir.path, "render " + scene + "--local-store --stats " + stats + " -o " + modelled).status, 0)
         << "existing outputs are kept without --overwrite";
 }
