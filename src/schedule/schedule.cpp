@@ -84,10 +84,10 @@ private:
 // starts with the w-th of N contiguous runs of packets and claims them one by one from a word only it
 // writes. Neighbouring packets, which read the same nodes and triangles and write neighbouring pixels,
 // so go to the same core, and claims do not contend. With one shared counter, neighbours went to
-// different cores: on the 2-core development machine packets took 5-11% longer with two workers than
-// with one, against 0-4% now, and each claim moved the counter's cache line across (0.15 us a packet;
-// docs/SCALING.md). A worker whose run is done takes the second half of the run with the most left,
-// so the last packets are still handed out one at a time.
+// different cores: on the 2-core development machine SIMD packets took 7-8% longer with two workers
+// than with one (medians of interleaved runs), against 2% now, and each claim moved the counter's
+// cache line across (0.15 us a packet; docs/SCALING.md). A worker whose run is done takes the second
+// half of the run with the most left, so the last packets are still handed out one at a time.
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
               const Timer& frame, std::vector<PaddedLoad>& loads) {
     const auto workers = static_cast<unsigned>(loads.size());
