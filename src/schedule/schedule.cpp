@@ -41,7 +41,7 @@ void timed(WorkerLoad& load, TracePacket&& trace_packet) {
 // whatever happened to the range in between.
 class alignas(64) PacketRange {
 public:
-    // Owner only, while the range is empty (no thief touches an empty range).
+    // Owner only, while the range is empty (no thief modifies an empty range).
     void assign(std::uint32_t begin, std::uint32_t end) { bits_.store(pack(begin, end), std::memory_order_relaxed); }
 
     // Owner only: takes the first packet left (an empty range's begin passes its end by one).
@@ -81,13 +81,14 @@ private:
 };
 
 // Pull dispatch by work stealing (as Cilk's and TBB's schedulers; Blumofe & Leiserson 1999): worker w
-// starts with the w-th of N contiguous runs of packets and claims them one by one from a word only it
-// writes. Neighbouring packets, which read the same nodes and triangles and write neighbouring pixels,
-// so go to the same core, and claims do not contend. With one shared counter, neighbours went to
-// different cores: on the 2-core development machine SIMD packets took 7-8% longer with two workers
-// than with one (medians of interleaved runs), against 2% now, and each claim moved the counter's
-// cache line across (0.15 us a packet; docs/SCALING.md). A worker whose run is done takes the second
-// half of the run with the most left, so the last packets are still handed out one at a time.
+// starts with the w-th of N contiguous runs of packets and claims them one by one from a word of its
+// own (thieves only cut its end). Neighbouring packets, which read the same nodes and triangles and
+// write neighbouring pixels, so go to the same core, and claims do not contend. With one shared
+// counter, neighbours went to different cores: on the 2-core development machine SIMD packets took
+// 7-8% longer with two workers than with one (medians of interleaved runs), against 2% now, and each
+// claim moved the counter's cache line across (0.15 us a packet; docs/SCALING.md). A worker whose run
+// is done takes the second half of the run with the most left, so the last packets are still handed
+// out one at a time.
 bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
               const Timer& frame, std::vector<PaddedLoad>& loads) {
     const auto workers = static_cast<unsigned>(loads.size());

@@ -46,10 +46,15 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
     std::lock_guard lock(run_mutex_);
     while (threads_.size() + 1 < n) {
         // A new thread's signal starts at 0 and the thread waits for it to change: the first run it
-        // takes part in is the first bump, whether that comes before or after the thread starts.
+        // takes part in is the first bump, whether that comes before or after the thread starts. The
+        // signal joins the team only once its thread has started (a start that fails throws and
+        // leaves the team as it was: thread t always waits on signals_[t]).
         const auto t = static_cast<unsigned>(threads_.size());
-        Signal& signal = *signals_.emplace_back(std::make_unique<Signal>());
-        threads_.emplace_back([this, t, &signal] { loop(t, signal); });
+        auto signal = std::make_unique<Signal>();
+        threads_.reserve(threads_.size() + 1);
+        signals_.reserve(signals_.size() + 1);
+        threads_.emplace_back([this, t, &s = *signal] { loop(t, s); });
+        signals_.push_back(std::move(signal));
     }
     set_affinity(pin);
 #ifdef __linux__
@@ -88,7 +93,7 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
 }
 
 void WorkerTeam::loop(unsigned t, Signal& signal) {
-    // A thread's first wait sleeps at once: a new team has run nothing yet.
+    // The first wait sleeps at once (no spin) until the thread's first run bumps its signal from 0.
     std::uint64_t seen = 0;
     for (std::chrono::microseconds spin{0};;) {
         seen = wait_for_change(signal.generation, seen, spin);
