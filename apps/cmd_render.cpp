@@ -148,8 +148,9 @@ Runner add_render(CLI::App& app) {
     cmd->add_option("-o,--output", o->out, "Output image: .png (sRGB) or .pfm (exact floats)")->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace the output file if it exists");
     cmd->add_option("--packet", o->packet, "Packet edge P: workers trace P x P rays at a time")->capture_default_str();
-    cmd->add_option("--dispatch", o->dispatch, "How packets reach workers: pull (each worker a run of packets, stealing when done) or mailbox (the "
-                                               "study's master)")
+    cmd->add_option("--dispatch", o->dispatch,
+                    "How packets reach workers: pull (each worker a run of packets, stealing when done) or "
+                    "mailbox (the study's master)")
         ->capture_default_str();
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
