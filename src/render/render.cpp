@@ -21,7 +21,7 @@ Vec3 sky(const Vec3& dir) {
 
 // Buffers of one worker, allocated once per render, reused for every packet. On cache lines of their
 // own: workers update their vectors' ends and counters and write the buffers on every packet.
-struct alignas(64) PacketWork {
+struct alignas(kCacheLine) PacketWork {
     CacheLineVector<Ray> rays, shadow_rays;
     CacheLineVector<Hit> hits;
     CacheLineVector<std::uint8_t> occluded;

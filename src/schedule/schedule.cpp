@@ -22,7 +22,7 @@ void store(Image& image, const PixelRect& r, std::span<const Vec3> colours) {
 bool cancelled(const ScheduleOptions& o) { return o.cancel && o.cancel->load(std::memory_order_relaxed); }
 
 // A worker's load, on a cache line of its own: each worker adds to it after every packet.
-struct alignas(64) PaddedLoad {
+struct alignas(kCacheLine) PaddedLoad {
     WorkerLoad load;
 };
 
@@ -39,7 +39,7 @@ void timed(WorkerLoad& load, TracePacket&& trace_packet) {
 // to begin) and a thief's cut (a compare-and-swap of end) are each one atomic step on it. The word is
 // the range's whole state, so a compare-and-swap that finds the value it read is right to succeed,
 // whatever happened to the range in between.
-class alignas(64) PacketRange {
+class alignas(kCacheLine) PacketRange {
 public:
     // Owner only, while the range is empty (no thief modifies an empty range).
     void assign(std::uint32_t begin, std::uint32_t end) { bits_.store(pack(begin, end), std::memory_order_relaxed); }
@@ -100,7 +100,7 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
     for (unsigned w = 0; w < workers; ++w)
         ranges[w].assign(static_cast<std::uint32_t>(count * w / workers), static_cast<std::uint32_t>(count * (w + 1) / workers));
     // Touched only for a progress callback (each worker counts its own packets in its load).
-    alignas(64) std::atomic<std::size_t> done{0};
+    alignas(kCacheLine) std::atomic<std::size_t> done{0};
     // Allocated here: a worker that allocates gets a malloc arena of its own, on every frame.
     std::vector<CacheLineVector<Vec3>> buffers(workers, CacheLineVector<Vec3>(static_cast<std::size_t>(grid.packet) * grid.packet));
     auto steal = [&](unsigned w) {
@@ -154,7 +154,7 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
 // hundreds of cycles, not an operating-system wake-up.
 struct Mailbox {
     enum State : int { idle, work, done, stop };
-    alignas(64) std::atomic<int> state{idle};
+    alignas(kCacheLine) std::atomic<int> state{idle};
     PixelRect rect{};
     CacheLineVector<Vec3> colours;
 };
