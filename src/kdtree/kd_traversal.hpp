@@ -1,5 +1,6 @@
-// kd-tree traversal kernels for single rays: Havran's TA_rec, the classic stack traversal and the
-// study's branchless variant. Each is one template over the query (closest or any hit), the memory
+// kd-tree traversal kernels for single rays: Havran's TA_rec here, and the classic stack traversal
+// and the study's branchless variant through the kernels it shares with the BIH
+// (accel/stack_traversal.hpp). Each is one template over the query (closest or any hit), the memory
 // policy (direct, or the local-store model's software caches) and the work counters; all three visit
 // cells conservatively (traversal.hpp) and so return exactly the hits of brute force.
 //
@@ -8,7 +9,7 @@
 // memory is direct.
 #pragma once
 
-#include "accel/traversal.hpp"
+#include "accel/stack_traversal.hpp"
 #include "kd_tree.hpp"
 
 namespace cellrt::detail {
@@ -30,95 +31,32 @@ struct Mailbox {
     }
 };
 
-// Tests the triangles of a leaf; true when an any-hit query is answered.
-template <class Query, class Memory, class Counters>
-bool kd_leaf(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c, Mailbox& tested) {
-    c.leaf();
-    const std::uint32_t end = leaf.first() + leaf.count();
-    for (std::uint32_t k = leaf.first(); k < end; ++k) {
-        const std::uint32_t prim = mem.index(k);
-        if (tested.seen(prim)) continue;
-        c.triangle();
-        if (q.test(r.watertight, mem.triangle(prim), prim)) return true;
-    }
-    return false;
-}
+// The kd-tree's hooks for the shared stack traversals (accel/stack_traversal.hpp): one plane per
+// inner node, which ends the left child's cell and begins the right one's.
+struct KdCells {
+    using Node = KdNode;
+    static constexpr int kMaxDepth = kKdMaxDepth;
+    static constexpr bool kGaps = false;
+    static float plane(const KdNode& n, std::uint32_t) { return n.split(); }
 
-// Classic stack traversal (pbrt's, Wald's): entries (node, tmin, tmax); the near child is the one on
-// the side the direction points from, the far one is pushed when the ray reaches it.
-// `_from` traverses the subtree of node `index` for the ray's interval [tmin, tmax] in that cell (the
-// SIMD packets hand a lane over to it when the lane is the last one left in a subtree).
-template <class Query, class Memory, class Counters>
-bool kd_traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
-                               float tmin, float tmax) {
-    Mailbox tested;
-    StackEntry stack[kKdMaxDepth + 1];
-    int sp = 0;
-    for (;;) {
-        KdNode n = mem.node(index);
-        while (!n.is_leaf()) {
-            c.node();
-            mem.touch_node(n.children());
-            const int a = n.axis();
-            const float t = (n.split() - r.org[a]) * r.inv_dir[a];
-            const std::uint32_t near = n.children() + r.dir_neg[a], far = n.children() + (r.dir_neg[a] ^ 1u);
-            // NaN t (the ray lies in the plane) passes both tests: both children are visited.
-            const bool near_ok = !(tmin > t + r.margin), far_ok = !(t - r.margin > tmax);
-            if (near_ok) {
-                if (far_ok) stack[sp++] = {far, max_keep(tmin, t - r.margin), tmax};
-                tmax = min_keep(tmax, t + r.margin);
-                index = near;
-            } else {
-                tmin = max_keep(tmin, t - r.margin);
-                index = far;
+    // A leaf's entries index the scene's triangles; the mailbox skips those tested in earlier leaves.
+    struct Leaves {
+        Mailbox tested;
+
+        template <class Memory, class Query, class Counters>
+        bool test(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+            c.leaf();
+            const std::uint32_t end = leaf.first() + leaf.count();
+            for (std::uint32_t k = leaf.first(); k < end; ++k) {
+                const std::uint32_t prim = mem.index(k);
+                if (tested.seen(prim)) continue;
+                c.triangle();
+                if (q.test(r.watertight, mem.triangle(prim), prim)) return true;
             }
-            n = mem.node(index);
+            return false;
         }
-        if (kd_leaf(n, mem, r, q, c, tested)) return true;
-        if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
-    }
-}
-
-template <class Query, class Memory, class Counters>
-bool kd_traverse_branched(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    float tmin, tmax;
-    return r.clip(tree.bounds, tmin, tmax) && kd_traverse_branched_from(mem, r, q, c, 0, tmin, tmax);
-}
-
-// The study's branchless traversal (section 4.5, after Havran 2007): at an inner node both entries
-// are written, far first, and the stack pointer moves by the two comparison results; the next node
-// is then popped from the top. The only branch left in the inner loop is the loop's own.
-template <class Query, class Memory, class Counters>
-bool kd_traverse_branchless(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
-    float tmin, tmax;
-    if (!r.clip(tree.bounds, tmin, tmax)) return false;
-    Mailbox tested;
-    StackEntry stack[kKdMaxDepth + 2];
-    int sp = 0;
-    std::uint32_t index = 0;
-    for (;;) {
-        KdNode n = mem.node(index);
-        while (!n.is_leaf()) {
-            c.node();
-            mem.touch_node(n.children());
-            const int a = n.axis();
-            const float t = (n.split() - r.org[a]) * r.inv_dir[a];
-            const std::uint32_t near = n.children() + r.dir_neg[a], far = near ^ 1u;
-            const bool near_ok = !(tmin > t + r.margin), far_ok = !(t - r.margin > tmax);
-            stack[sp] = {far, max_keep(tmin, t - r.margin), tmax};
-            sp += far_ok;
-            stack[sp] = {near, tmin, min_keep(tmax, t + r.margin)};
-            sp += near_ok;
-            --sp;
-            index = stack[sp].node;
-            tmin = stack[sp].tmin;
-            tmax = stack[sp].tmax;
-            n = mem.node(index);
-        }
-        if (kd_leaf(n, mem, r, q, c, tested)) return true;
-        if (!pop_live(stack, sp, 0, q, index, tmin, tmax)) return false;
-    }
-}
+    };
+};
 
 // Havran's TA_rec (thesis, appendix C, the "B" variant): the stack holds points on the ray, not
 // intervals. Each inner node is classified by comparing the coordinates of the current entry and exit
@@ -138,7 +76,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
     };
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
-    Mailbox tested;
+    KdCells::Leaves leaves;
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
     const float reach = r.margin * length(r.dir);
     const Vec3 o = abs(r.org);
@@ -183,7 +121,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
             }
             n = mem.node(index);
         }
-        if (kd_leaf(n, mem, r, q, c, tested)) return true;
+        if (leaves.test(n, mem, r, q, c)) return true;
         // Continue with the node that starts at the leaf's exit point, unless it starts past the answer.
         for (;;) {
             if (stack[ex].far == kNone) return false;
@@ -208,10 +146,10 @@ decltype(auto) with_kd_kernel(KdTraversal t, Fn&& fn) {
         return kd_traverse_rec(tree, mem, r, q, c);
     };
     auto branched = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return kd_traverse_branched(tree, mem, r, q, c);
+        return traverse_branched<KdCells>(tree, mem, r, q, c);
     };
     auto branchless = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return kd_traverse_branchless(tree, mem, r, q, c);
+        return traverse_branchless<KdCells>(tree, mem, r, q, c);
     };
     switch (t) {
         case KdTraversal::rec: return fn(rec);

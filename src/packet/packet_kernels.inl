@@ -301,10 +301,10 @@ template <class Tree, class Query>
         return c.single([&](auto& counters) {
             if constexpr (std::is_same_v<Tree, KdTree>) {
                 DirectMemory<KdNode> mem{tree.nodes.data(), tree.indices.data(), triangles};
-                return kd_traverse_branched_from(mem, r, single_query, counters, index, tmin, tmax);
+                return traverse_branched_from<KdCells>(mem, r, single_query, counters, index, tmin, tmax);
             } else {
                 DirectMemory<BihNode> mem{tree.nodes.data(), tree.prims.data(), tree.triangles.data()};
-                return bih_traverse_branched_from(mem, r, single_query, counters, index, tmin, tmax);
+                return traverse_branched_from<BihCells>(mem, r, single_query, counters, index, tmin, tmax);
             }
         });
     });
