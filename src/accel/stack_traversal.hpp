@@ -25,6 +25,14 @@
 
 namespace cellrt::detail {
 
+// The stacks the kernels declare, in entries (the local-store model budgets them): the branched kernel
+// pushes at most one far child per level; the branchless one writes one entry past its top and, with
+// gaps, keeps a sentinel at the bottom.
+template <class Cells>
+inline constexpr int kBranchedStackSize = Cells::kMaxDepth + 1;
+template <class Cells>
+inline constexpr int kBranchlessStackSize = Cells::kMaxDepth + 2 + (Cells::kGaps ? 1 : 0);
+
 // `_from` traverses the subtree of node `index` for the ray's interval [tmin, tmax] in that cell (the
 // SIMD packets hand a lane over to it when the lane is the last one left in a subtree). The near child
 // is visited first; the far one is pushed when the ray reaches it too.
@@ -32,7 +40,7 @@ template <class Cells, class Query, class Memory, class Counters>
 bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
                             float tmin, float tmax) {
     typename Cells::Leaves leaves;
-    StackEntry stack[Cells::kMaxDepth + 1];
+    StackEntry stack[kBranchedStackSize<Cells>];
     int sp = 0;
     for (;;) {
         typename Cells::Node n = mem.node(index);
@@ -80,7 +88,7 @@ bool traverse_branchless(const Tree& tree, Memory& mem, const TraversalRay& r, Q
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     typename Cells::Leaves leaves;
-    StackEntry stack[Cells::kMaxDepth + 3];
+    StackEntry stack[kBranchlessStackSize<Cells>];
     int bottom = 0;
     if constexpr (Cells::kGaps) stack[bottom++] = {Cells::kSentinel, tmin, tmax};
     int sp = bottom;

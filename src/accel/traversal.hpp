@@ -121,6 +121,7 @@ struct StackEntry {
     std::uint32_t node;
     float tmin, tmax;
 };
+static_assert(sizeof(StackEntry) == 12, "a stack entry is a node index and an interval");
 
 // Pops the next stacked cell that can still hold the answer, skipping those that start past the
 // query's cull distance; false when no entry above `bottom` is left. `sp` ends on the popped slot.

@@ -65,15 +65,19 @@ struct KdCells {
 // A leaf's exit point is the next cell's entry. For robustness a point carries two positions: where
 // the near child is left (t + margin) and where the far child is entered (t - margin), and the
 // one-sided cases require both points to lie a coordinate margin clear of the plane.
+struct KdRecPoint {
+    float t_exit, t_entry;  // as the exit of the near child / the entry of the far child
+    Vec3 exit, entry;
+    std::uint32_t far;      // the node that starts at this point (~0u: the ray's end)
+    int prev;               // the exit point of `far`
+};
+static_assert(sizeof(KdRecPoint) == 40, "the local-store model budgets TA_rec's stack at 40 bytes a point");
+inline constexpr int kKdRecStackSize = kKdMaxDepth + 3;
+
 template <class Query, class Memory, class Counters>
 bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
     constexpr std::uint32_t kNone = ~0u;
-    struct Point {
-        float t_exit, t_entry;  // as the exit of the near child / the entry of the far child
-        Vec3 exit, entry;
-        std::uint32_t far;      // the node that starts at this point (kNone: the ray's end)
-        int prev;               // the exit point of `far`
-    };
+    using Point = KdRecPoint;
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     KdCells::Leaves leaves;
@@ -81,7 +85,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
     const float reach = r.margin * length(r.dir);
     const Vec3 o = abs(r.org);
     const float tol = reach + kMarginScale * std::max(o.x, std::max(o.y, o.z));
-    Point stack[kKdMaxDepth + 3];
+    Point stack[kKdRecStackSize];
     int en = 0, ex = 1;
     stack[en].t_entry = tmin;
     stack[en].entry = r.at(tmin);

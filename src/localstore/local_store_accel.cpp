@@ -30,10 +30,11 @@ struct KdStructure {
     static const std::vector<std::string>& traversal_names() { return kd_traversal_names(); }
     static Traversal traversal(const std::string& name) { return kd_traversal(name); }
     static bool branchless(Traversal t) { return t == KdTraversal::branchless; }
-    // The kernels' stacks as they declare them: TA_rec's points on the ray (two t, two points, a node
-    // and a link: 40 bytes), the others' (node, tmin, tmax) entries.
+    // The kernels' stacks as they declare them: TA_rec's points on the ray, the others' (node, tmin,
+    // tmax) entries (the branchless kernel's stack, one entry larger than the branched one's).
     static std::size_t stack_bytes(Traversal t) {
-        return t == KdTraversal::rec ? (kKdMaxDepth + 3) * 40 : (kKdMaxDepth + 2) * 12;
+        return t == KdTraversal::rec ? kKdRecStackSize * sizeof(KdRecPoint)
+                                     : kBranchlessStackSize<KdCells> * sizeof(StackEntry);
     }
     template <class Fn>
     static void with_kernel(Traversal t, Fn&& fn) {
@@ -63,7 +64,7 @@ struct BihStructure {
     static const std::vector<std::string>& traversal_names() { return bih_traversal_names(); }
     static Traversal traversal(const std::string& name) { return bih_traversal(name); }
     static bool branchless(Traversal t) { return t == BihTraversal::branchless; }
-    static std::size_t stack_bytes(Traversal) { return (kBihMaxDepth + 3) * 12; }
+    static std::size_t stack_bytes(Traversal) { return kBranchlessStackSize<BihCells> * sizeof(StackEntry); }
     template <class Fn>
     static void with_kernel(Traversal t, Fn&& fn) {
         with_bih_kernel(t, std::forward<Fn>(fn));
