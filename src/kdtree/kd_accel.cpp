@@ -1,7 +1,6 @@
 #include "kd_accel.hpp"
 
-#include "cellrt/timer.hpp"
-#include "packet/packet.hpp"
+#include "accel/tree_accelerator.hpp"
 
 namespace cellrt::detail {
 
@@ -35,67 +34,18 @@ KdTraversal kd_traversal(const std::string& name) {
     return name == "rec" ? KdTraversal::rec : name == "branched" ? KdTraversal::branched : KdTraversal::branchless;
 }
 
-namespace {
-
-const char* name(KdTraversal t) {
-    return t == KdTraversal::rec ? "rec" : t == KdTraversal::branched ? "branched" : "branchless";
+void KdStructure::closest_packets(const PacketKernels& k, std::span<const Ray> rays, std::span<Hit> hits,
+                                  TraversalCounters* counters) const {
+    k.kd_closest(tree, triangles.data(), rays, hits, counters);
 }
 
-class KdAccelerator final : public Accelerator {
-public:
-    KdAccelerator(std::span<const Triangle> triangles, const KdBuildParams& params, KdTraversal traversal,
-                  const PacketKernels* packets)
-        : triangles_(triangles), params_(params), traversal_(traversal), packets_(packets) {
-        Timer timer;
-        tree_ = build_kdtree(triangles, params);
-        build_seconds_ = timer.seconds();
-    }
-
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        if (packets_) return packets_->kd_closest(tree_, triangles_.data(), rays, hits, counters);
-        DirectMemory<KdNode> mem = memory();
-        with_kd_kernel(traversal_, [&](auto kernel) {
-            closest_hits(tree_.bounds, rays, hits, counters,
-                         [&](const TraversalRay& r, auto& q, auto& c) { return kernel(tree_, mem, r, q, c); });
-        });
-    }
-
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        if (packets_) return packets_->kd_any(tree_, triangles_.data(), rays, occluded, counters);
-        DirectMemory<KdNode> mem = memory();
-        with_kd_kernel(traversal_, [&](auto kernel) {
-            any_hits(tree_.bounds, rays, occluded, counters,
-                     [&](const TraversalRay& r, auto& q, auto& c) { return kernel(tree_, mem, r, q, c); });
-        });
-    }
-
-    AccelStats stats() const override {
-        AccelStats s{"kd", build_seconds_,
-                     tree_.nodes.size() * sizeof(KdNode) + tree_.indices.size() * sizeof(std::uint32_t),
-                     {{"traversal", packets_ ? "packet" : name(traversal_)},
-                      {"simd lanes", packets_ ? std::to_string(packets_->lanes) : "off"}}};
-        for (auto& f : kd_report(tree_, params_)) s.figures.push_back(std::move(f));
-        return s;
-    }
-
-private:
-    DirectMemory<KdNode> memory() const { return {tree_.nodes.data(), tree_.indices.data(), triangles_.data()}; }
-
-    std::span<const Triangle> triangles_;
-    KdBuildParams params_;
-    KdTraversal traversal_;
-    const PacketKernels* packets_;
-    KdTree tree_;
-    double build_seconds_ = 0.0;
-};
-
-}  // namespace
+void KdStructure::any_packets(const PacketKernels& k, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                              TraversalCounters* counters) const {
+    k.kd_any(tree, triangles.data(), rays, occluded, counters);
+}
 
 std::unique_ptr<Accelerator> make_kdtree(std::span<const Triangle> triangles, const AccelConfig& config) {
-    const KdBuildParams params = read_kd_params(config);
-    const KdTraversal traversal = kd_traversal(traversal_or_default(config, kd_traversal_names(), "kd"));
-    return std::make_unique<KdAccelerator>(triangles, params, traversal, packet_kernels_for(config));
+    return std::make_unique<TreeAccelerator<KdStructure>>(triangles, config, packet_kernels_for(config));
 }
 
 }  // namespace cellrt::detail

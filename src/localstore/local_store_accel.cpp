@@ -20,71 +20,13 @@ namespace cellrt {
 namespace detail {
 namespace {
 
-// What the model needs of a structure: its kernels and their stacks, and its arrays.
-struct KdStructure {
-    using Node = KdNode;
-    using Traversal = KdTraversal;
-    static constexpr const char* kName = "kd";
-
-    // The same traversals and parameters as for direct memory (kd_accel.hpp).
-    static const std::vector<std::string>& traversal_names() { return kd_traversal_names(); }
-    static Traversal traversal(const std::string& name) { return kd_traversal(name); }
-    static bool branchless(Traversal t) { return t == KdTraversal::branchless; }
-    // The kernels' stacks as they declare them: TA_rec's points on the ray, the others' (node, tmin,
-    // tmax) entries (the branchless kernel's stack, one entry larger than the branched one's).
-    static std::size_t stack_bytes(Traversal t) {
-        return t == KdTraversal::rec ? kKdRecStackSize * sizeof(KdRecPoint)
-                                     : kBranchlessStackSize<KdCells> * sizeof(StackEntry);
-    }
-    template <class Fn>
-    static void with_kernel(Traversal t, Fn&& fn) {
-        with_kd_kernel(t, std::forward<Fn>(fn));
-    }
-
-    KdStructure(std::span<const Triangle> tris, const AccelConfig& config)
-        : params(read_kd_params(config)), triangles(tris), tree(build_kdtree(tris, params)) {}
-    std::span<const KdNode> nodes() const { return tree.nodes; }
-    std::span<const std::uint32_t> entries() const { return tree.indices; }
-    std::span<const Triangle> triangle_array() const { return triangles; }
-    std::uint64_t leaf_bound() const { return tree.indices.size(); }
-    const Box3& bounds() const { return tree.bounds; }
-    std::vector<std::pair<std::string, std::string>> report() const { return kd_report(tree, params); }
-    std::size_t memory_bytes() const { return nodes().size_bytes() + entries().size_bytes(); }
-
-    KdBuildParams params;
-    std::span<const Triangle> triangles;
-    KdTree tree;
-};
-
-struct BihStructure {
-    using Node = BihNode;
-    using Traversal = BihTraversal;
-    static constexpr const char* kName = "bih";
-
-    static const std::vector<std::string>& traversal_names() { return bih_traversal_names(); }
-    static Traversal traversal(const std::string& name) { return bih_traversal(name); }
-    static bool branchless(Traversal t) { return t == BihTraversal::branchless; }
-    static std::size_t stack_bytes(Traversal) { return kBranchlessStackSize<BihCells> * sizeof(StackEntry); }
-    template <class Fn>
-    static void with_kernel(Traversal t, Fn&& fn) {
-        with_bih_kernel(t, std::forward<Fn>(fn));
-    }
-
-    BihStructure(std::span<const Triangle> tris, const AccelConfig& config)
-        : params(read_bih_params(config)), tree(build_bih(tris, params)) {}
-    std::span<const BihNode> nodes() const { return tree.nodes; }
-    std::span<const std::uint32_t> entries() const { return tree.prims; }
-    std::span<const Triangle> triangle_array() const { return tree.triangles; }
-    std::uint64_t leaf_bound() const { return tree.triangles.size(); }
-    const Box3& bounds() const { return tree.bounds; }
-    std::vector<std::pair<std::string, std::string>> report() const { return bih_report(tree, params); }
-    std::size_t memory_bytes() const {
-        return nodes().size_bytes() + entries().size_bytes() + triangle_array().size_bytes();
-    }
-
-    BihBuildParams params;
-    BihTree tree;
-};
+// The kernels' stacks as they declare them, which the local store must hold: TA_rec's points on the
+// ray, the others' (node, tmin, tmax) entries (the branchless kernel's stack, one entry larger than
+// the branched one's).
+std::size_t stack_bytes(KdTraversal t) {
+    return t == KdTraversal::rec ? kKdRecStackSize * sizeof(KdRecPoint) : kBranchlessStackSize<KdCells> * sizeof(StackEntry);
+}
+std::size_t stack_bytes(BihTraversal) { return kBranchlessStackSize<BihCells> * sizeof(StackEntry); }
 
 // A built structure and its image in the model's main memory, shared by every configuration traced over it.
 template <class S>
@@ -94,7 +36,7 @@ struct Built {
         image.entries = memory.add(structure.entries().data(), structure.entries().size_bytes());
         image.triangles = memory.add(structure.triangle_array().data(), structure.triangle_array().size_bytes());
         image.node_count = static_cast<std::uint32_t>(structure.nodes().size());
-        image.leaf_bound = structure.leaf_bound();
+        image.leaf_bound = structure.entries().size();
         image.depth = node_depths(structure.nodes());
         for (std::size_t i = 0; i < image.node_count; ++i)
             if (image.depth[i] != image.kNoDepth && structure.nodes()[i].is_leaf())
@@ -151,7 +93,7 @@ public:
           config_(config),
           traversal_name_(validated_traversal(S::kName, S::traversal_names(), traversal)),
           traversal_(S::traversal(traversal_name_)),
-          allocations_(allocate_local_store(config, S::stack_bytes(traversal_))),
+          allocations_(allocate_local_store(config, stack_bytes(traversal_))),
           workers_([this] { return WorkerStore(config_, built_->memory); }) {}
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
@@ -210,7 +152,7 @@ private:
         WorkerStore& store = workers_.local();
         CachedMemory<Node> mem(store, built_->image, config_);
         const CostModel& cost = config_.cost;
-        const std::uint32_t step = cost.inner_step(S::branchless(traversal_));
+        const std::uint32_t step = cost.inner_step(traversal_ == S::Traversal::branchless);
         S::with_kernel(traversal_, [&](auto kernel) {
             auto through_model = [&](const TraversalRay& r, auto& q, auto& c) {
                 store.begin_ray();
@@ -240,7 +182,7 @@ std::unique_ptr<LocalStoreAccelerator> make_model(std::span<const Triangle> tria
                                                   const LocalStoreConfig& local_store) {
     // Refuse a bad traversal or configuration before spending time on the build.
     const std::string traversal = validated_traversal(S::kName, S::traversal_names(), config.traversal);
-    allocate_local_store(local_store, S::stack_bytes(S::traversal(traversal)));
+    allocate_local_store(local_store, stack_bytes(S::traversal(traversal)));
     auto built = std::make_shared<const Built<S>>(triangles, config);
     return std::make_unique<ModelAccelerator<S>>(std::move(built), local_store, traversal);
 }
