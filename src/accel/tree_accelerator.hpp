@@ -37,21 +37,13 @@ public:
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
         if (packets_) return structure_.closest_packets(*packets_, rays, hits, counters);
-        DirectMemory<typename S::Node> mem = memory();
-        S::with_kernel(traversal_, [&](auto kernel) {
-            closest_hits(structure_.bounds(), rays, hits, counters,
-                         [&](const TraversalRay& r, auto& q, auto& c) { return kernel(structure_.tree, mem, r, q, c); });
-        });
+        with_direct_kernel([&](auto& kernel) { closest_hits(structure_.bounds(), rays, hits, counters, kernel); });
     }
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
         if (packets_) return structure_.any_packets(*packets_, rays, occluded, counters);
-        DirectMemory<typename S::Node> mem = memory();
-        S::with_kernel(traversal_, [&](auto kernel) {
-            any_hits(structure_.bounds(), rays, occluded, counters,
-                     [&](const TraversalRay& r, auto& q, auto& c) { return kernel(structure_.tree, mem, r, q, c); });
-        });
+        with_direct_kernel([&](auto& kernel) { any_hits(structure_.bounds(), rays, occluded, counters, kernel); });
     }
 
     AccelStats stats() const override {
@@ -70,8 +62,18 @@ private:
         return s;
     }
 
-    DirectMemory<typename S::Node> memory() const {
-        return {structure_.nodes().data(), structure_.entries().data(), structure_.triangle_array().data()};
+    // Calls `batch(kernel)` with the chosen traversal over direct memory as kernel(ray, query, counters):
+    // one dispatch per batch.
+    template <class Batch>
+    void with_direct_kernel(Batch&& batch) const {
+        DirectMemory<typename S::Node> mem{structure_.nodes().data(), structure_.entries().data(),
+                                           structure_.triangle_array().data()};
+        S::with_kernel(traversal_, [&](auto kernel) {
+            auto over_memory = [&](const TraversalRay& r, auto& q, auto& c) {
+                return kernel(structure_.tree, mem, r, q, c);
+            };
+            batch(over_memory);
+        });
     }
 
     std::string traversal_name_;

@@ -24,7 +24,8 @@ namespace {
 // ray, the others' (node, tmin, tmax) entries (the branchless kernel's stack, one entry larger than
 // the branched one's).
 std::size_t stack_bytes(KdTraversal t) {
-    return t == KdTraversal::rec ? kKdRecStackSize * sizeof(KdRecPoint) : kBranchlessStackSize<KdCells> * sizeof(StackEntry);
+    if (t == KdTraversal::rec) return kKdRecStackSize * sizeof(KdRecPoint);
+    return kBranchlessStackSize<KdCells> * sizeof(StackEntry);
 }
 std::size_t stack_bytes(BihTraversal) { return kBranchlessStackSize<BihCells> * sizeof(StackEntry); }
 
