@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/subtree.hpp"
+#include "kernel/subtree.hpp"
 #include "cellrt/builtin.hpp"
 #include "kdtree/kd_tree.hpp"
 #include "scenes.hpp"

@@ -18,7 +18,7 @@
 #include <memory>
 #include <string>
 
-#include "accel/traversal.hpp"
+#include "kernel/traversal.hpp"
 #include "cellrt/timer.hpp"
 #include "packet/packet.hpp"
 

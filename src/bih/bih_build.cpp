@@ -17,7 +17,7 @@
 // no split is cheaper than testing its triangles.
 //
 // Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
-// known in advance. Large ranges are built as parallel tasks (accel/subtree.hpp keeps the layout
+// known in advance. Large ranges are built as parallel tasks (kernel/subtree.hpp keeps the layout
 // independent of the thread count).
 #include <algorithm>
 #include <cmath>
@@ -28,7 +28,7 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
-#include "accel/subtree.hpp"
+#include "kernel/subtree.hpp"
 #include "bih_tree.hpp"
 
 namespace cellrt::detail {

@@ -1,6 +1,6 @@
 // BIH traversal kernels for single rays (Wächter & Keller 2006, section 2.3): branched, and the
 // study's branchless variant (its section 4.5 applied to BIH), both the kernels the BIH shares with
-// the kd-tree (accel/stack_traversal.hpp), which visit nodes conservatively (accel/traversal.hpp) and
+// the kd-tree (kernel/stack_traversal.hpp), which visit nodes conservatively (kernel/traversal.hpp) and
 // so return exactly the hits of brute force.
 //
 // The direction's sign on the node's axis decides which child is near: for a positive direction the
@@ -9,12 +9,12 @@
 // child's clip(sign ^ 1). A ray between the planes of a split with a gap visits neither.
 #pragma once
 
-#include "accel/stack_traversal.hpp"
+#include "kernel/stack_traversal.hpp"
 #include "bih_tree.hpp"
 
 namespace cellrt::detail {
 
-// The BIH's hooks for the shared stack traversals (accel/stack_traversal.hpp): two clip planes per
+// The BIH's hooks for the shared stack traversals (kernel/stack_traversal.hpp): two clip planes per
 // inner node, with a gap between them that a ray can pass through.
 struct BihCells {
     using Node = BihNode;

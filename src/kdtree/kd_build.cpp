@@ -28,7 +28,7 @@
 #include <tbb/task_group.h>
 
 #include "cellrt/error.hpp"
-#include "accel/subtree.hpp"
+#include "kernel/subtree.hpp"
 #include "kd_tree.hpp"
 
 namespace cellrt::detail {

@@ -1,6 +1,6 @@
 // kd-tree traversal kernels for single rays: Havran's TA_rec here, and the classic stack traversal
 // and the study's branchless variant through the kernels it shares with the BIH
-// (accel/stack_traversal.hpp). Each is one template over the query (closest or any hit), the memory
+// (kernel/stack_traversal.hpp). Each is one template over the query (closest or any hit), the memory
 // policy (direct, or the local-store model's software caches) and the work counters; all three visit
 // cells conservatively (traversal.hpp) and so return exactly the hits of brute force.
 //
@@ -9,7 +9,7 @@
 // memory is direct.
 #pragma once
 
-#include "accel/stack_traversal.hpp"
+#include "kernel/stack_traversal.hpp"
 #include "kd_tree.hpp"
 
 namespace cellrt::detail {
@@ -31,7 +31,7 @@ struct Mailbox {
     }
 };
 
-// The kd-tree's hooks for the shared stack traversals (accel/stack_traversal.hpp): one plane per
+// The kd-tree's hooks for the shared stack traversals (kernel/stack_traversal.hpp): one plane per
 // inner node, which ends the left child's cell and begins the right one's.
 struct KdCells {
     using Node = KdNode;

@@ -1,5 +1,5 @@
 // The memory-access policy of the local-store model: the interface of DirectMemory
-// (accel/traversal.hpp) over a worker's software caches, so that the kd-tree and BIH kernels run
+// (kernel/traversal.hpp) over a worker's software caches, so that the kd-tree and BIH kernels run
 // through the model unchanged. Nodes, leaf index entries (kd: the leaf lists; BIH: the scene index of
 // a reordered triangle) go through the node cache, triangles through the triangle cache.
 //

@@ -8,7 +8,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
-#include "accel/traversal.hpp"
+#include "kernel/traversal.hpp"
 #include "bih/bih_accel.hpp"
 #include "cached_memory.hpp"
 #include "cellrt/error.hpp"

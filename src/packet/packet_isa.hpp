@@ -16,7 +16,7 @@
 #include <immintrin.h>
 #endif
 
-#include "accel/traversal.hpp"
+#include "kernel/traversal.hpp"
 #include "bih/bih_traversal.hpp"
 #include "kdtree/kd_traversal.hpp"
 #include "packet.hpp"

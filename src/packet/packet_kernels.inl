@@ -2,7 +2,7 @@
 // lane, included inside an instruction-set namespace after simd/lanes.inl (see packet_<isa>.cpp).
 //
 // Exactness. A lane computes what the single-ray kernels compute for its ray: the same conservative
-// plane tests with the same margin (accel/traversal.hpp) and the watertight triangle test with the
+// plane tests with the same margin (kernel/traversal.hpp) and the watertight triangle test with the
 // same operations in the same order (triangle.hpp), so its hit is the brute-force hit bit for bit. A
 // packet visits a node when any of its active lanes would; lanes that would not are masked off, and
 // a lane that tests a triangle its own ray would never have reached only adds a candidate that brute

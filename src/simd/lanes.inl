@@ -51,6 +51,6 @@ inline F select(I m, F a, F b) { return m ? a : b; }
 inline I select(I m, I a, I b) { return m ? a : b; }
 inline U select(I m, U a, U b) { return m ? a : b; }
 
-// The scalar kernels' NaN-keeping min/max (accel/traversal.hpp), lane by lane.
+// The scalar kernels' NaN-keeping min/max (kernel/traversal.hpp), lane by lane.
 inline F min_keep(F kept, F x) { return select(x < kept, x, kept); }
 inline F max_keep(F kept, F x) { return select(x > kept, x, kept); }

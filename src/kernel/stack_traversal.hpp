@@ -21,7 +21,7 @@
 // when memory is direct.
 #pragma once
 
-#include "accel/traversal.hpp"
+#include "kernel/traversal.hpp"
 
 namespace cellrt::detail {
 
