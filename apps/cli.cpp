@@ -48,7 +48,7 @@ void print_stats(const AccelStats& s) {
     std::printf("structure        %s\n", s.name.c_str());
     std::printf("build time       %.3f s\n", s.build_seconds);
     std::printf("memory           %.2f MiB\n", static_cast<double>(s.memory_bytes) / (1024.0 * 1024.0));
-    for (const auto& [k, v] : s.figures) std::printf("%-16s %s\n", k.c_str(), v.c_str());
+    for (const auto& [k, v] : s.figures()) std::printf("%-16s %s\n", k.c_str(), v.c_str());
 }
 
 Progress::Progress() : enabled_(::isatty(STDERR_FILENO)) {}

@@ -1,32 +1,59 @@
 // `cellrt info SCENE [--accel KIND ...]`: scene facts, and with --accel the structure's build report.
+// `cellrt info --params KIND`: the structure's build parameters (name, default, range, meaning) and
+// traversals, from the table that validates them.
 #include <cstdio>
 
+#include "cellrt/error.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
 
 namespace cellrt::cli {
+namespace {
+
+void print_params(const std::string& kind) {
+    const ParamTable& table = accelerator_params(kind);
+    std::printf("%s parameters (-P NAME=VALUE):\n\n", kind.c_str());
+    if (table.empty()) std::printf("(none)\n");
+    else std::printf("%s", param_table_markdown(table).c_str());
+    std::string traversals;
+    for (const std::string& t : accelerator_traversals(kind)) traversals += (traversals.empty() ? "" : ", ") + t;
+    std::printf("\n%s traversals (--traversal; the first is the default): %s\n", kind.c_str(), traversals.c_str());
+}
+
+void print_scene(const Scene& scene, double load_seconds) {
+    const Box3 b = scene.bounds();
+    std::printf("scene            %s\n", scene.name.c_str());
+    std::printf("triangles        %zu\n", scene.triangles.size());
+    std::printf("bounds           (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+    std::printf("memory           %.2f MiB\n",
+                static_cast<double>(scene.triangles.size() * sizeof(Triangle)) / (1024.0 * 1024.0));
+    std::printf("load time        %.3f s\n", load_seconds);
+    std::printf("image            %dx%d\n", scene.width, scene.height);
+}
+
+}  // namespace
 
 Runner add_info(CLI::App& app) {
     struct Options {
         std::string scene;
+        std::string params;
         AccelOptions accel;
     };
     auto o = std::make_shared<Options>();
     auto* cmd = app.add_subcommand("info", "Print scene facts; with --accel, build the structure and print its report");
-    cmd->add_option("scene", o->scene, scene_help())->required();
+    cmd->add_option("scene", o->scene, scene_help());
+    cmd->add_option("--params", o->params, "Print the build parameters and traversals of this structure, then stop")
+        ->check(CLI::IsMember(accelerator_kinds()));
     o->accel.add_to(*cmd, true);
     return [o] {
+        if (!o->params.empty()) {
+            print_params(o->params);
+            return 0;
+        }
+        if (o->scene.empty()) throw Error("info: give a scene, or --params KIND");
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
-        const double load_s = load_timer.seconds();
-        const Box3 b = scene.bounds();
-        std::printf("scene            %s\n", scene.name.c_str());
-        std::printf("triangles        %zu\n", scene.triangles.size());
-        std::printf("bounds           (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
-        std::printf("memory           %.2f MiB\n",
-                    static_cast<double>(scene.triangles.size() * sizeof(Triangle)) / (1024.0 * 1024.0));
-        std::printf("load time        %.3f s\n", load_s);
-        std::printf("image            %dx%d\n", scene.width, scene.height);
+        print_scene(scene, load_timer.seconds());
         if (!o->accel.kind.empty()) print_stats(make_accelerator(scene.triangles, o->accel.config())->stats());
         return 0;
     };

@@ -163,16 +163,10 @@ int run_profile(const ProfileOptions& o) {
     ro.cancel = &g_cancel;
     const auto accel = make_accelerator(scene.triangles, config);
     const AccelStats st = accel->stats();
-    std::string traversal = "-", lanes = "off";
-    for (const auto& [k, v] : st.figures) {
-        if (k == "traversal") traversal = v;
-        if (k == "simd lanes") lanes = v;
-    }
-
     std::printf("profile                %s: %zu triangles, %s (%s%s), %dx%d, packet %d, 1 render thread\n",
-                scene.name.c_str(), scene.triangles.size(), st.name.c_str(), traversal.c_str(),
-                lanes == "off" ? "" : (", " + config.simd + ", " + lanes + " lanes").c_str(), ro.width, ro.height,
-                ro.packet);
+                scene.name.c_str(), scene.triangles.size(), st.name.c_str(), st.traversal.c_str(),
+                st.simd_lanes ? (", " + config.simd + ", " + std::to_string(st.simd_lanes) + " lanes").c_str() : "",
+                ro.width, ro.height, ro.packet);
     if (hardware)
         std::printf("counts                 hardware counters (perf_event_open), user space only\n");
     else
@@ -218,9 +212,9 @@ int run_profile(const ProfileOptions& o) {
         nlohmann::json j = {{"scene", scene.name},
                             {"triangles", scene.triangles.size()},
                             {"accel", st.name},
-                            {"traversal", traversal},
-                            {"simd", lanes == "off" ? "off" : config.simd},
-                            {"simd_lanes", lanes},
+                            {"traversal", st.traversal},
+                            {"simd", st.simd_lanes ? config.simd : "off"},
+                            {"simd_lanes", st.simd_lanes ? std::to_string(st.simd_lanes) : "off"},
                             {"params", o.accel.params},
                             {"width", ro.width},
                             {"height", ro.height},

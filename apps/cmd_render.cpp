@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "localstore/local_store.hpp"
+#include "accel/local_store_registry.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
@@ -197,7 +197,7 @@ Runner add_render(CLI::App& app) {
                                 {"packet", ro.packet},          {"primary_rays", rs.primary_rays},
                                 {"shadow_rays", rs.shadow_rays}, {"build_seconds", st.build_seconds},
                                 {"render_seconds", rs.seconds}, {"figures", nlohmann::json::object()}};
-            for (const auto& [k, v] : st.figures) j["figures"][k] = v;
+            for (const auto& [k, v] : st.figures()) j["figures"][k] = v;
             // Each worker's share of the frame (docs/SCALING.md): the packets it traced, the time it
             // spent tracing them, and when it started and finished, from the frame's start.
             j["dispatch"] = to_string(ro.dispatch);

@@ -105,7 +105,7 @@ TEST(Bih, SahSplitLowersTheSahCost) {
     const Scene& scene = test::cached_scene("builtin:city?tris=20000");
     auto cost = [&](const std::string& split) {
         const AccelStats s = make_accelerator(scene.triangles, bih("", {{"split", split}}))->stats();
-        return std::stod(std::map<std::string, std::string>(s.figures.begin(), s.figures.end()).at("SAH cost"));
+        return s.tree.value().sah_cost;
     };
     EXPECT_LT(cost("sah"), 0.5 * cost("global"));
 }
@@ -114,10 +114,24 @@ TEST(Bih, ReportsItsBuild) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const AccelStats s = make_accelerator(scene.triangles, bih(""))->stats();
     EXPECT_EQ(s.name, "bih");
-    std::map<std::string, std::string> f(s.figures.begin(), s.figures.end());
-    for (const char* key : {"nodes", "leaves", "empty leaves", "empty-space nodes", "max depth", "mean leaf depth",
-                            "tris per leaf", "SAH cost", "traversal"})
-        EXPECT_TRUE(f.count(key)) << key;
+    ASSERT_TRUE(s.tree.has_value());
+    const TreeReport& t = *s.tree;
+    EXPECT_EQ(t.nodes, t.inner_nodes + t.leaves);
+    EXPECT_GT(t.leaves, t.empty_leaves);
+    ASSERT_TRUE(t.empty_space_nodes.has_value());
+    EXPECT_LE(*t.empty_space_nodes, t.inner_nodes);
+    EXPECT_GT(t.max_depth, 0);
+    EXPECT_LE(t.max_depth, t.depth_limit);
+    EXPECT_GT(t.triangles_per_leaf, 0.0);
+    EXPECT_DOUBLE_EQ(t.references_per_triangle, 1.0);  // nothing is duplicated
+    EXPECT_GT(t.sah_cost, 0.0);
+    EXPECT_EQ(s.traversal, "branched");
+    EXPECT_EQ(s.setting("split"), "global");
+    // The printed report is derived from the typed one.
+    const auto figures = s.figures();
+    const std::map<std::string, std::string> f(figures.begin(), figures.end());
+    EXPECT_EQ(f.at("empty-space nodes"), std::to_string(*t.empty_space_nodes));
+    EXPECT_EQ(f.at("nodes"), std::to_string(t.nodes));
     // Memory is known in advance: nodes, the reordered triangles and their scene indices.
     EXPECT_GE(s.memory_bytes, scene.triangles.size() * (sizeof(Triangle) + 4));
 }

@@ -227,11 +227,7 @@ TEST(Embree, PacketTraversalsGiveTheSingleRayAnswers) {
     const test::ReferenceAnswers& ref = test::cached_reference(kSpheres, scene.triangles);
     const auto single = make_accelerator(scene.triangles, embree_config("single"));
     const Answers want = answer(*single, ref.rays);
-    const std::string native = [&] {
-        for (const auto& [k, v] : single->stats().figures)
-            if (k == "native packets") return v;
-        return std::string();
-    }();
+    const std::string native = single->stats().setting("native packets").value_or("");
     for (const char* width : {"4", "8", "16"}) {
         const std::string traversal = std::string("packet") + width;
         const bool offered = (',' + native + ',').find(std::string(",") + width + ",") != std::string::npos;
@@ -410,13 +406,12 @@ TEST(Embree, CountsRaysOnlyAndReportsItsBuild) {
     EXPECT_GT(stats.build_seconds, 0.0);
     // At least the vertex and index buffers (48 bytes per triangle) plus a BVH.
     EXPECT_GT(stats.memory_bytes, 48 * scene.triangles.size());
-    const std::map<std::string, std::string> figures(stats.figures.begin(), stats.figures.end());
-    EXPECT_EQ(figures.at("quality"), "high");
-    EXPECT_EQ(figures.at("robust"), "false");
-    EXPECT_EQ(figures.at("compact"), "false");
-    EXPECT_EQ(figures.at("threads"), "1");
-    EXPECT_EQ(figures.at("traversal"), "single");
-    EXPECT_EQ(figures.at("triangles"), std::to_string(scene.triangles.size()));
+    EXPECT_EQ(stats.setting("quality"), "high");
+    EXPECT_EQ(stats.setting("robust"), "false");
+    EXPECT_EQ(stats.setting("compact"), "false");
+    EXPECT_EQ(stats.setting("threads"), "1");
+    EXPECT_EQ(stats.traversal, "single");
+    EXPECT_EQ(stats.triangles, scene.triangles.size());
 }
 
 TEST(Embree, RejectsBadParametersAndTraversals) {

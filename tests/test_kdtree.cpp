@@ -8,7 +8,7 @@
 
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
-#include "kdtree/kd_accel.hpp"
+#include "kdtree/kd_structure.hpp"
 #include "kdtree/kd_tree.hpp"
 #include "ray_suite.hpp"
 #include "scenes.hpp"
@@ -92,12 +92,24 @@ TEST(KdTree, ReportsItsBuild) {
     const AccelStats s = make_accelerator(scene.triangles, kd(""))->stats();
     EXPECT_EQ(s.name, "kd");
     EXPECT_GT(s.memory_bytes, 0u);
-    std::map<std::string, std::string> f(s.figures.begin(), s.figures.end());
-    for (const char* key : {"nodes", "leaves", "empty leaves", "max depth", "mean leaf depth", "tris per leaf",
-                            "refs per tri", "SAH cost", "traversal"})
-        EXPECT_TRUE(f.count(key)) << key;
-    EXPECT_EQ(f["traversal"], "branched");
-    EXPECT_GE(std::stod(f["refs per tri"]), 1.0);
+    ASSERT_TRUE(s.tree.has_value());
+    const TreeReport& t = *s.tree;
+    EXPECT_EQ(t.nodes, t.inner_nodes + t.leaves);
+    EXPECT_GT(t.leaves, t.empty_leaves);
+    EXPECT_FALSE(t.empty_space_nodes.has_value());
+    EXPECT_GT(t.max_depth, 0);
+    EXPECT_LE(t.max_depth, t.depth_limit);
+    EXPECT_GT(t.mean_leaf_depth, 0.0);
+    EXPECT_GE(t.references_per_triangle, 1.0);
+    EXPECT_GT(t.sah_cost, 0.0);
+    EXPECT_EQ(s.traversal, "branched");
+    EXPECT_EQ(s.simd_lanes, 0);
+    EXPECT_EQ(s.triangles, scene.triangles.size());
+    EXPECT_EQ(s.setting("method"), "hybrid");
+    const auto figures = s.figures();
+    const std::map<std::string, std::string> f(figures.begin(), figures.end());
+    EXPECT_EQ(f.at("traversal"), "branched");
+    EXPECT_EQ(f.at("leaves"), std::to_string(t.leaves));
 }
 
 // Trees for SIMD packets weigh a traversal step as kKdPacketTraversalCost unless told otherwise;

@@ -21,7 +21,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "kdtree/kd_traversal.hpp"
-#include "localstore/local_store.hpp"
+#include "accel/local_store_registry.hpp"
 #include "localstore/worker_store.hpp"
 #include "ray_suite.hpp"
 #include "scenes.hpp"
@@ -519,7 +519,7 @@ TEST(LocalStoreCli, RefusesBadOptionsNamingThem) {
              {"--local-store --local-store-kib 8", "--local-store-kib 8"},
              {"--local-store --node-cache 4096x64", "more than the budget"},
              {"--local-store --simd avx2", "not SIMD packets"},
-             {"--local-store --accel brute", "--accel kd or bih"},
+             {"--local-store --accel brute", "runs the trees (kd, bih), not 'brute'"},
              {"--local-store -P leaf_size=-3", "leaf_size=-3"},
          }) {
         const CliRun run = run_cli(dir.path, "render " + args + out);

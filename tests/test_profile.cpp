@@ -173,7 +173,7 @@ TEST(ProfileWorkCounters, BatchesSumTheirRaysWork) {
     std::vector<Hit> hits(rays.size());
     TraversalCounters c;
     detail::closest_hits(tree.bounds, rays, hits, &c, [&](const detail::TraversalRay& r, auto& q, auto& k) {
-        return detail::traverse_branched<detail::KdCells>(tree, mem, r, q, k);
+        return detail::traverse_branched<detail::KdTraits>(tree, mem, r, q, k);
     });
     EXPECT_EQ(c.rays, rays.size());
     EXPECT_EQ(c.nodes, sum.nodes);

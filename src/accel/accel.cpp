@@ -1,57 +1,94 @@
+// The registry: every structure this binary offers, by kind. The trees come from the one list
+// (structures.hpp); brute force and Embree are backends of their own.
 #include "cellrt/accel.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
+#include <functional>
 
+#include "accel/local_store_registry.hpp"
+#include "accel/structures.hpp"
+#include "accel/tree_accelerator.hpp"
 #include "cellrt/brute_force.hpp"
 #include "cellrt/error.hpp"
-#include "bih/bih_accel.hpp"
-#include "kdtree/kd_accel.hpp"
+#include "kernel/named.hpp"
+#include "localstore/model_accelerator.hpp"
 #ifdef CELLRT_HAVE_EMBREE
-#include "../embree/embree_accel.hpp"
+#include "embree/embree_accel.hpp"
 #endif
 
 namespace cellrt {
-
 namespace {
 
-using Factory = std::unique_ptr<Accelerator> (*)(std::span<const Triangle>, const AccelConfig&);
+using Factory = std::function<std::unique_ptr<Accelerator>(std::span<const Triangle>, const AccelConfig&)>;
+using LocalStoreFactory = std::unique_ptr<LocalStoreAccelerator> (*)(std::span<const Triangle>, const AccelConfig&,
+                                                                     const LocalStoreConfig&);
 
 struct Entry {
-    const char* kind;
+    std::string kind;
     Factory make;
+    const ParamTable* params;
+    std::vector<std::string> traversals;
+    LocalStoreFactory local_store = nullptr;  // trees only
 };
 
-// The one list of structures this binary offers.
-constexpr Entry kAccelerators[] = {
-    {"brute", &make_brute_force},
-    {"kd", &detail::make_kdtree},
-    {"bih", &detail::make_bih},
+std::vector<Entry> make_entries() {
+    std::vector<Entry> entries{{"brute", &make_brute_force, &brute_force_params(), brute_force_traversals()}};
+    detail::TreeStructures::for_each([&]<class S>(std::type_identity<S>) {
+        entries.push_back({S::kName,
+                           [](std::span<const Triangle> triangles, const AccelConfig& config) -> std::unique_ptr<Accelerator> {
+                               return std::make_unique<detail::TreeAccelerator<S>>(
+                                   triangles, config, detail::packet_kernels_for(config));
+                           },
+                           &S::param_table(), detail::names_of(S::kTraversals), &detail::make_model<S>});
+    });
 #ifdef CELLRT_HAVE_EMBREE
-    {"embree", &make_embree},
+    entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
 #endif
-};
+    return entries;
+}
 
-std::string join(const std::vector<std::string>& items) {
-    std::string out;
-    for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
-    return out;
+const std::vector<Entry>& entries() {
+    static const std::vector<Entry> all = make_entries();
+    return all;
+}
+
+const Entry& entry(const std::string& kind) {
+    for (const Entry& e : entries())
+        if (e.kind == kind) return e;
+    throw Error("unknown accelerator '" + kind + "' (choose one of: " + detail::join_names(accelerator_kinds()) + ")");
 }
 
 }  // namespace
 
 std::vector<std::string> accelerator_kinds() {
     std::vector<std::string> kinds;
-    for (const Entry& e : kAccelerators) kinds.emplace_back(e.kind);
+    for (const Entry& e : entries()) kinds.push_back(e.kind);
     return kinds;
 }
 
+const ParamTable& accelerator_params(const std::string& kind) { return *entry(kind).params; }
+
+const std::vector<std::string>& accelerator_traversals(const std::string& kind) { return entry(kind).traversals; }
+
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config) {
-    for (const Entry& e : kAccelerators)
-        if (config.kind == e.kind) return e.make(triangles, config);
-    throw Error("unknown accelerator '" + config.kind + "' (choose one of: " + join(accelerator_kinds()) + ")");
+    return entry(config.kind).make(triangles, config);
+}
+
+std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
+                                                                    const AccelConfig& config,
+                                                                    const LocalStoreConfig& local_store) {
+    const Entry& e = entry(config.kind);
+    if (!e.local_store) {
+        std::vector<std::string> trees;
+        for (const Entry& t : entries())
+            if (t.local_store) trees.push_back(t.kind);
+        throw Error("the local-store model runs the trees (" + detail::join_names(trees) + "), not '" + config.kind +
+                    "'");
+    }
+    if (config.simd != "off")
+        throw Error("the local-store model runs the single-ray kernels, not SIMD packets (simd '" + config.simd +
+                    "')");
+    return e.local_store(triangles, config, local_store);
 }
 
 AccelConfig parse_accel_config(std::string spec) {
@@ -77,78 +114,6 @@ AccelConfig parse_accel_config(std::string spec) {
     c.kind = spec.substr(0, colon);
     if (colon != std::string::npos) c.traversal = spec.substr(colon + 1);
     return c;
-}
-
-std::string traversal_or_default(const AccelConfig& config, const std::vector<std::string>& choices,
-                                 const std::string& structure) {
-    if (config.traversal.empty()) return choices.front();
-    if (std::find(choices.begin(), choices.end(), config.traversal) == choices.end())
-        throw Error("traversal '" + config.traversal + "' is not offered by " + structure +
-                    " (choose one of: " + join(choices) + ")");
-    return config.traversal;
-}
-
-ParamReader::ParamReader(const AccelConfig& config, std::string structure)
-    : remaining_(config.params), structure_(std::move(structure)) {}
-
-const std::string* ParamReader::take(const std::string& name) {
-    auto it = remaining_.find(name);
-    if (it == remaining_.end()) return nullptr;
-    consumed_.push_back(it->second);
-    remaining_.erase(it);
-    return &consumed_.back();
-}
-
-double ParamReader::get_number(const std::string& name, double default_value, double min_value, double max_value) {
-    const std::string* text = take(name);
-    if (!text) return default_value;
-    char* end = nullptr;
-    errno = 0;
-    const double value = std::strtod(text->c_str(), &end);
-    if (text->empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value))
-        throw Error(structure_ + " parameter " + name + "='" + *text + "' is not a number");
-    if (value < min_value || value > max_value)
-        throw Error(structure_ + " parameter " + name + "=" + *text + " is out of range [" +
-                    std::to_string(min_value) + ", " + std::to_string(max_value) + "]");
-    return value;
-}
-
-int ParamReader::get_int(const std::string& name, int default_value, int min_value, int max_value) {
-    const std::string* text = take(name);
-    if (!text) return default_value;
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(text->c_str(), &end, 10);
-    if (text->empty() || *end != '\0' || errno == ERANGE)
-        throw Error(structure_ + " parameter " + name + "='" + *text + "' is not an integer");
-    if (value < min_value || value > max_value)
-        throw Error(structure_ + " parameter " + name + "=" + *text + " is out of range [" +
-                    std::to_string(min_value) + ", " + std::to_string(max_value) + "]");
-    return static_cast<int>(value);
-}
-
-bool ParamReader::get_bool(const std::string& name, bool default_value) {
-    const std::string* text = take(name);
-    if (!text) return default_value;
-    if (*text == "1" || *text == "true" || *text == "on") return true;
-    if (*text == "0" || *text == "false" || *text == "off") return false;
-    throw Error(structure_ + " parameter " + name + "='" + *text + "' is not a boolean (true/false, on/off, 1/0)");
-}
-
-std::string ParamReader::get_choice(const std::string& name, const std::string& default_value,
-                                    const std::vector<std::string>& choices) {
-    const std::string* text = take(name);
-    if (!text) return default_value;
-    if (std::find(choices.begin(), choices.end(), *text) == choices.end())
-        throw Error(structure_ + " parameter " + name + "='" + *text + "' is not one of: " + join(choices));
-    return *text;
-}
-
-void ParamReader::finish() const {
-    if (remaining_.empty()) return;
-    std::vector<std::string> names;
-    for (const auto& [k, v] : remaining_) names.push_back(k);
-    throw Error("unknown " + structure_ + " parameter(s): " + join(names));
 }
 
 }  // namespace cellrt

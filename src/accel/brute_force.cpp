@@ -1,7 +1,8 @@
 #include "cellrt/brute_force.hpp"
 
 #include "cellrt/timer.hpp"
-#include "packet/packet.hpp"
+#include "accel/packet_table.hpp"
+#include "kernel/param_reader.hpp"
 
 namespace cellrt {
 namespace {
@@ -9,10 +10,10 @@ namespace {
 class BruteForce final : public Accelerator {
 public:
     BruteForce(std::span<const Triangle> triangles, const detail::PacketKernels* packets)
-        : triangles_(triangles), packets_(packets) {}
+        : triangles_(triangles), packets_(packets ? &packets->brute : nullptr), lanes_(packets ? packets->lanes : 0) {}
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        if (packets_) return packets_->brute_closest(triangles_, rays, hits, counters);
+        if (packets_) return packets_->closest(triangles_, rays, hits, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
             Hit best = miss_for(ray);
@@ -28,7 +29,7 @@ public:
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
-        if (packets_) return packets_->brute_any(triangles_, rays, occluded, counters);
+        if (packets_) return packets_->any(triangles_, rays, occluded, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
             occluded[i] = 0;
@@ -45,7 +46,12 @@ public:
     }
 
     AccelStats stats() const override {
-        return {"brute", 0.0, 0, {{"triangles", std::to_string(triangles_.size())}}};
+        AccelStats s;
+        s.name = "brute";
+        s.traversal = packets_ ? "packet" : "loop";
+        s.simd_lanes = lanes_;
+        s.triangles = triangles_.size();
+        return s;
     }
 
 private:
@@ -55,15 +61,26 @@ private:
         counters->triangles += n * triangles_.size();
     }
     std::span<const Triangle> triangles_;
-    const detail::PacketKernels* packets_;
+    const detail::BrutePacketKernels* packets_;
+    int lanes_;
 };
 
 }  // namespace
 
+const ParamTable& brute_force_params() {
+    static const ParamTable none;
+    return none;
+}
+
+const std::vector<std::string>& brute_force_traversals() {
+    static const std::vector<std::string> names{"loop"};
+    return names;
+}
+
 std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangles, const AccelConfig& config) {
-    ParamReader params(config, "brute");
-    traversal_or_default(config, {"loop"}, "brute");
+    detail::ParamReader params(brute_force_params(), config, "brute");
     params.finish();
+    detail::choose_traversal(brute_force_traversals(), config.traversal, "brute");
     return std::make_unique<BruteForce>(triangles, detail::packet_kernels_for(config));
 }
 

@@ -1,26 +1,14 @@
-// A tree structure (the kd-tree, the BIH) behind the accelerator boundary: built once and timed, then
-// traced by its single-ray kernels over direct memory or by its SIMD packets. One class serves both
-// structures; what differs is the structure's description `S` (KdStructure in kd_accel.hpp,
-// BihStructure in bih_accel.hpp), which the local-store model (src/localstore) runs on too:
-//
-//   Node, Traversal, kName             the node type, the traversal enum, the --accel name
-//   traversal_names(), traversal(n)    the single-ray traversals by name, the default first
-//   with_kernel(traversal, fn)         calls fn(kernel), the traversal as a function object
-//                                      kernel(tree, memory, ray, query, counters)
-//   S(triangles, config)               reads and validates the -P parameters, then builds
-//   tree, bounds(), nodes(), entries(), triangle_array()
-//                                      the built tree and the three arrays its kernels read
-//   memory_bytes(), report()           the structure's size and its build report
-//   closest_packets(kernels, ...), any_packets(kernels, ...)
-//                                      the SIMD packet kernels' entry points for this structure
+// A tree structure behind the accelerator interface: built once and timed, then traced by its
+// single-ray kernels over direct memory or by its SIMD packets. One class serves every tree through
+// its descriptor `S` (kdtree/kd_structure.hpp describes the members).
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include "kernel/traversal.hpp"
+#include "accel/packet_table.hpp"
 #include "cellrt/timer.hpp"
-#include "packet/packet.hpp"
+#include "kernel/param_reader.hpp"
 
 namespace cellrt::detail {
 
@@ -30,27 +18,33 @@ public:
     // Every option is validated before the build: the traversal here, the SIMD set by the caller (in
     // `packets`), the parameters by S's constructor before it builds.
     TreeAccelerator(std::span<const Triangle> triangles, const AccelConfig& config, const PacketKernels* packets)
-        : traversal_name_(traversal_or_default(config, S::traversal_names(), S::kName)),
-          traversal_(S::traversal(traversal_name_)),
-          packets_(packets),
+        : traversal_name_(choose_traversal(names_of(S::kTraversals), config.traversal, S::kName)),
+          traversal_(value_named(S::kTraversals, traversal_name_, "traversal")),
+          packets_(packets ? &packets->template tree<typename S::Traits>() : nullptr),
+          lanes_(packets ? packets->lanes : 0),
           structure_(build(triangles, config)) {}
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        if (packets_) return structure_.closest_packets(*packets_, rays, hits, counters);
+        if (packets_) return packets_->closest(structure_.view(), rays, hits, counters);
         with_direct_kernel([&](auto& kernel) { closest_hits(structure_.bounds(), rays, hits, counters, kernel); });
     }
 
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                   TraversalCounters* counters) const override {
-        if (packets_) return structure_.any_packets(*packets_, rays, occluded, counters);
+        if (packets_) return packets_->any(structure_.view(), rays, occluded, counters);
         with_direct_kernel([&](auto& kernel) { any_hits(structure_.bounds(), rays, occluded, counters, kernel); });
     }
 
     AccelStats stats() const override {
-        AccelStats s{S::kName, build_seconds_, structure_.memory_bytes(),
-                     {{"traversal", packets_ ? "packet" : traversal_name_},
-                      {"simd lanes", packets_ ? std::to_string(packets_->lanes) : "off"}}};
-        for (auto& f : structure_.report()) s.figures.push_back(std::move(f));
+        AccelStats s;
+        s.name = S::kName;
+        s.traversal = packets_ ? "packet" : traversal_name_;
+        s.simd_lanes = lanes_;
+        s.build_seconds = build_seconds_;
+        s.memory_bytes = structure_.memory_bytes();
+        s.triangles = structure_.triangle_array().size();
+        s.tree = structure_.report();
+        s.settings = structure_.settings();
         return s;
     }
 
@@ -66,8 +60,7 @@ private:
     // one dispatch per batch.
     template <class Batch>
     void with_direct_kernel(Batch&& batch) const {
-        DirectMemory<typename S::Node> mem{structure_.nodes().data(), structure_.entries().data(),
-                                           structure_.triangle_array().data()};
+        auto mem = structure_.view().memory();
         S::with_kernel(traversal_, [&](auto kernel) {
             auto over_memory = [&](const TraversalRay& r, auto& q, auto& c) {
                 return kernel(structure_.tree, mem, r, q, c);
@@ -78,7 +71,8 @@ private:
 
     std::string traversal_name_;
     typename S::Traversal traversal_;
-    const PacketKernels* packets_;
+    const TreePacketKernels<typename S::Traits>* packets_;
+    int lanes_;
     double build_seconds_ = 0.0;  // before structure_: build() sets it while structure_ is initialised
     S structure_;
 };

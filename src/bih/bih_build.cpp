@@ -21,7 +21,6 @@
 // independent of the thread count).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 
@@ -37,11 +36,8 @@ namespace {
 constexpr std::size_t kParallelMin = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The SAH's bins per axis and its costs: a node visit and a triangle test, the kd-tree's default
-// costs (kd_tree.hpp), so that the two structures' reports compare.
+// The SAH's bins per axis (its costs and largest leaf are parameters: BihBuildParams).
 constexpr int kSahBins = 32;
-constexpr double kSahTraversal = 15.0, kSahIntersection = 20.0;
-constexpr std::uint32_t kSahMaxLeaf = 16;
 
 double area(const Box3& b) {
     if (b.is_empty()) return 0.0;
@@ -223,14 +219,15 @@ private:
                 if (count == 0 || count == r.size()) continue;
                 Box3 cell = r.box;
                 cell.hi[a] = std::min(cell.hi[a], left_hi);
-                const double cost = kSahTraversal + kSahIntersection * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
+                const double cost = p_.traversal_cost + p_.intersection_cost * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
                 if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
             }
         }
-        // A leaf when no split beats testing every triangle, up to kSahMaxLeaf triangles; beyond, the
+        // A leaf when no split beats testing every triangle, up to sah_max_leaf triangles; beyond, the
         // cheapest split even so (a leaf that large would be tested by every ray that reaches it).
-        const bool leaf_is_cheaper = !(best_cost < kSahIntersection * r.size());
-        if (best_axis < 0 || (leaf_is_cheaper && r.size() <= kSahMaxLeaf)) return Decision{};
+        const bool leaf_is_cheaper = !(best_cost < p_.intersection_cost * r.size());
+        if (best_axis < 0 || (leaf_is_cheaper && r.size() <= static_cast<std::uint32_t>(p_.sah_max_leaf)))
+            return Decision{};
         const float lo = centres.lo[best_axis], scale = kSahBins / (centres.hi[best_axis] - lo);
         return split_at(r, best_axis, [&](std::uint32_t t) { return bin_of(centres_[t][best_axis], lo, scale) <= best_bin; });
     }
@@ -301,65 +298,11 @@ private:
     std::vector<std::uint32_t> order_;
 };
 
-struct Totals {
-    std::size_t inner = 0, leaves = 0, empty_leaves = 0, cuts = 0, triangles = 0, depth_sum = 0;
-    int max_depth = 0;
-    double cost = 0.0;
-};
-
-// Walks the hierarchy with each node's box (the parent's box cut by the node's clip plane).
-void walk(const BihTree& tree, std::uint32_t index, const Box3& box, int depth, Totals& t) {
-    const BihNode& n = tree.nodes[index];
-    t.max_depth = std::max(t.max_depth, depth);
-    if (n.is_leaf()) {
-        ++t.leaves;
-        t.triangles += n.count();
-        if (n.count() == 0) ++t.empty_leaves;
-        else t.depth_sum += static_cast<std::size_t>(depth);
-        t.cost += 20.0 * n.count() * area(box);  // the kd-tree's default costs, for comparison
-        return;
-    }
-    ++t.inner;
-    const int a = n.axis();
-    if (std::isinf(n.clip(0)) || std::isinf(n.clip(1))) ++t.cuts;
-    t.cost += 15.0 * area(box);
-    Box3 left = box, right = box;
-    left.hi[a] = std::min(left.hi[a], n.clip(0));
-    right.lo[a] = std::max(right.lo[a], n.clip(1));
-    walk(tree, n.children(), left, depth + 1, t);
-    walk(tree, n.children() + 1, right, depth + 1, t);
-}
-
-std::string fmt(const char* format, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, format, v);
-    return buf;
-}
-
 }  // namespace
 
 BihTree build_bih(std::span<const Triangle> triangles, const BihBuildParams& params) {
     if (triangles.size() > BihNode::kMaxIndex) throw Error("BIH: at most 2^30 triangles are supported");
     return BihBuilder(triangles, params).build();
-}
-
-std::vector<std::pair<std::string, std::string>> bih_report(const BihTree& tree, const BihBuildParams& params) {
-    Totals t;
-    walk(tree, 0, tree.bounds, 0, t);
-    const std::size_t full = t.leaves - t.empty_leaves;
-    const double root_area = area(tree.bounds);
-    return {
-        {"nodes", std::to_string(t.inner + t.leaves)},
-        {"inner nodes", std::to_string(t.inner)},
-        {"empty-space nodes", std::to_string(t.cuts)},
-        {"leaves", std::to_string(t.leaves)},
-        {"empty leaves", std::to_string(t.empty_leaves)},
-        {"depth limit", std::to_string(params.max_depth)},
-        {"max depth", std::to_string(t.max_depth)},
-        {"mean leaf depth", fmt("%.2f", full ? double(t.depth_sum) / double(full) : 0.0)},
-        {"tris per leaf", fmt("%.2f", full ? double(t.triangles) / double(full) : 0.0)},
-        {"SAH cost", fmt("%.2f", root_area > 0.0 ? t.cost / root_area : 0.0)},
-    };
 }
 
 }  // namespace cellrt::detail

@@ -16,12 +16,17 @@ namespace cellrt::detail {
 
 // The BIH's hooks for the shared stack traversals (kernel/stack_traversal.hpp): two clip planes per
 // inner node, with a gap between them that a ray can pass through.
-struct BihCells {
+struct BihTraits {
     using Node = BihNode;
     static constexpr int kMaxDepth = kBihMaxDepth;
     static constexpr bool kGaps = true;
     static constexpr std::uint32_t kSentinel = 1;  // the empty padding leaf after the root (bih_tree.hpp)
+    static constexpr bool kLeafEntriesIndexTriangles = false;
     static float plane(const BihNode& n, std::uint32_t side) { return n.clip(side); }
+    template <class Memory>
+    static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
+        return {mem.triangle(k), mem.index(k)};
+    }
 
     // A leaf is a range of the BIH's own reordered triangles; the scene's index is read only for a
     // candidate hit.
@@ -44,10 +49,10 @@ enum class BihTraversal { branched, branchless };
 template <class Fn>
 decltype(auto) with_bih_kernel(BihTraversal t, Fn&& fn) {
     auto branched = [](const BihTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branched<BihCells>(tree, mem, r, q, c);
+        return traverse_branched<BihTraits>(tree, mem, r, q, c);
     };
     auto branchless = [](const BihTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branchless<BihCells>(tree, mem, r, q, c);
+        return traverse_branchless<BihTraits>(tree, mem, r, q, c);
     };
     if (t == BihTraversal::branched) return fn(branched);
     return fn(branchless);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bih_node.hpp"
+#include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
 #include "cellrt/triangle.hpp"
 
@@ -34,6 +35,11 @@ struct BihBuildParams {
     // empty, its plane at infinity) is emitted if more than this fraction of the node's width on the
     // axis is empty (Wächter & Keller section 2.2; Sunflow's 1/1.3 rule is 0.23). 1 disables it.
     double empty_cut = 0.23;
+    // split=sah only: the SAH's cost of a node visit and of a triangle test (by default the kd-tree's,
+    // so that the two structures' trees compare), and the largest leaf it makes when no split is cheaper.
+    double traversal_cost = 15.0;
+    double intersection_cost = 20.0;
+    int sah_max_leaf = 16;
     unsigned threads = 0;  // 0: all hardware threads; the hierarchy is the same for every value
 };
 
@@ -47,6 +53,7 @@ struct BihTree {
 
 BihTree build_bih(std::span<const Triangle> triangles, const BihBuildParams& params);
 
-std::vector<std::pair<std::string, std::string>> bih_report(const BihTree& tree, const BihBuildParams& params);
+// The build report (bih_report.cpp).
+TreeReport bih_report(const BihTree& tree, const BihBuildParams& params);
 
 }  // namespace cellrt::detail

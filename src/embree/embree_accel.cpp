@@ -14,6 +14,7 @@
 
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
+#include "kernel/param_reader.hpp"
 
 namespace cellrt {
 namespace {
@@ -249,20 +250,22 @@ public:
     }
 
     AccelStats stats() const override {
-        return {"embree",
-                build_seconds_,
-                memory_.live(),
-                {{"triangles", std::to_string(triangle_count_)},
-                 {"quality", options_.quality},
-                 {"robust", options_.robust ? "true" : "false"},
-                 {"compact", options_.compact ? "true" : "false"},
-                 {"threads", options_.threads == 0 ? "all" : std::to_string(options_.threads)},
-                 {"traversal", options_.traversal},
-                 {"native packets", native_packets_},
-                 {"setup seconds", std::to_string(setup_seconds_)},
-                 {"peak bytes", std::to_string(memory_.peak())},
-                 {"counters", "rays only (Embree reports no node or triangle counts)"},
-                 {"library", "Embree " RTC_VERSION_STRING}}};
+        AccelStats s;
+        s.name = "embree";
+        s.traversal = options_.traversal;
+        s.build_seconds = build_seconds_;
+        s.memory_bytes = memory_.live();
+        s.triangles = triangle_count_;
+        s.settings = {{"quality", options_.quality},
+                      {"robust", options_.robust ? "true" : "false"},
+                      {"compact", options_.compact ? "true" : "false"},
+                      {"threads", options_.threads == 0 ? "all" : std::to_string(options_.threads)},
+                      {"native packets", native_packets_},
+                      {"setup seconds", std::to_string(setup_seconds_)},
+                      {"peak bytes", std::to_string(memory_.peak())},
+                      {"counters", "rays only (Embree reports no node or triangle counts)"},
+                      {"library", "Embree " RTC_VERSION_STRING}};
+        return s;
     }
 
 private:
@@ -441,14 +444,30 @@ private:
 
 }  // namespace
 
+const ParamTable& embree_params() {
+    using enum ParamType;
+    static const ParamTable table{
+        {"quality", choice, "medium", 0, 0, {"low", "medium", "high"},
+         "Embree's RTC_BUILD_QUALITY_*: Morton build, SAH build, SAH build with spatial splits (Embree's default: medium)"},
+        {"robust", boolean, "true", 0, 0, {},
+         "RTC_SCENE_FLAG_ROBUST: conservative box tests and Embree's watertight triangle test, the closest Embree comes "
+         "to cellrt's hit rule"},
+        {"compact", boolean, "false", 0, 0, {},
+         "RTC_SCENE_FLAG_COMPACT: triangles stored as vertex indices, less memory, slower queries"},
+    };
+    return table;
+}
+
+const std::vector<std::string>& embree_traversals() { return kTraversals; }
+
 std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, const AccelConfig& config) {
-    ParamReader params(config, "embree");
+    detail::ParamReader params(embree_params(), config, "embree");
     EmbreeOptions options;
-    options.quality = params.get_choice("quality", "medium", {"low", "medium", "high"});
-    options.robust = params.get_bool("robust", true);
-    options.compact = params.get_bool("compact", false);
+    options.quality = params.choice("quality");
+    options.robust = params.boolean("robust");
+    options.compact = params.boolean("compact");
     params.finish();
-    options.traversal = traversal_or_default(config, kTraversals, "embree");
+    options.traversal = detail::choose_traversal(kTraversals, config.traversal, "embree");
     options.width = kTraversalWidths[std::find(kTraversals.begin(), kTraversals.end(), options.traversal) -
                                      kTraversals.begin()];
     options.threads = config.threads;

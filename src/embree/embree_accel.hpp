@@ -2,15 +2,8 @@
 // same run, on the same rays (docs/EMBREE.md). Compiled only where Embree 3 was found
 // (CELLRT_HAVE_EMBREE).
 //
-// Build parameters (AccelConfig::params, validated by ParamReader):
-//   quality = low | medium | high   Embree's RTC_BUILD_QUALITY_*: Morton build, SAH build, SAH build
-//                                   with spatial splits. Default: medium (Embree's own default).
-//   robust  = true | false          RTC_SCENE_FLAG_ROBUST: conservative box tests and Embree's
-//                                   watertight Pluecker triangle test instead of Moeller-Trumbore; the
-//                                   closest Embree comes to cellrt's hit rule. Default: true.
-//   compact = true | false          RTC_SCENE_FLAG_COMPACT: triangles stored as vertex indices, less
-//                                   memory, slower queries. Default: false.
-// AccelConfig::threads: build threads (0: all hardware threads).
+// Build parameters: embree_params() (quality, robust, compact). AccelConfig::threads: build threads
+// (0: all hardware threads).
 //
 // Traversals (AccelConfig::traversal):
 //   single    (default) rtcIntersect1 / rtcOccluded1 per ray
@@ -19,10 +12,18 @@
 //             would emulate it, which is no yardstick), else make_embree throws.
 #pragma once
 
-#include "cellrt/accel.hpp"
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cellrt/accelerator.hpp"
+#include "cellrt/params.hpp"
 
 namespace cellrt {
 
 std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, const AccelConfig& config);
+const ParamTable& embree_params();
+const std::vector<std::string>& embree_traversals();
 
 }  // namespace cellrt

@@ -8,10 +8,10 @@
 // partition and merge, so that the build below the switch costs O(N log N). Straddling triangles are
 // clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes are tight.
 //
-// Speed, without changing a bit of the tree: events are single integers (Event), the recursion
-// reuses per-thread buffers by depth instead of allocating per node, the hot loops avoid branches
-// whose direction the data decides, and the sweep computes the SAH's divisions only for candidates
-// that may win (SplitSearch).
+// Speed, without changing a bit of the tree: events are single integers (Event, kd_event.hpp), the
+// recursion reuses per-thread buffers by depth instead of allocating per node, the hot loops avoid
+// branches whose direction the data decides, and the sweep computes the SAH's divisions only for
+// candidates that may win (SplitSearch, kd_sah.hpp). Clipping for perfect splits: kd_clip.hpp.
 //
 // Parallelism: the two children of a large node are built as separate tasks, each into its own node
 // array; a final pass lays the pieces out depth-first. The layout depends only on the tree, never on
@@ -29,6 +29,9 @@
 
 #include "cellrt/error.hpp"
 #include "kernel/subtree.hpp"
+#include "kd_clip.hpp"
+#include "kd_event.hpp"
+#include "kd_sah.hpp"
 #include "kd_tree.hpp"
 
 namespace cellrt::detail {
@@ -41,270 +44,10 @@ int KdBuildParams::depth_limit(std::size_t triangles) const {
 
 namespace {
 
-constexpr std::uint32_t kTriangleMask = (1u << 30) - 1;
+using namespace kdbuild;
+
 // Nodes with fewer references are built by one task.
 constexpr std::size_t kParallelMin = 2048;
-
-// Event types in sweep order at equal positions: ends before planars before starts (W&H section 4.2).
-enum EventType : std::uint32_t { kEnd = 0, kPlanar = 1, kStart = 2 };
-
-// An event packed into one integer whose order is the sweep order (position, type, triangle): the
-// high half holds the position's float bits mapped to an unsigned integer of the same order (all bits
-// of a negative flipped, the sign bit of the rest set), the low half type << 30 | triangle. A
-// triangle has one event of each type per axis, so no two events of a list are equal: every correct
-// sort or merge of a list gives the same sequence. One difference from the order of floats: that has
-// -0 == +0 (and orders the events there by type and triangle), the integers put -0 just before +0;
-// the sweep treats both as one position (run_position).
-class Event {
-public:
-    Event() = default;
-    Event(float pos, EventType type, std::uint32_t triangle)
-        : bits_(std::uint64_t{ordered(pos)} << 32 | type << 30 | triangle) {}
-
-    float pos() const {
-        const auto o = static_cast<std::uint32_t>(bits_ >> 32);
-        return std::bit_cast<float>(o & kSign ? o & ~kSign : ~o);
-    }
-    // The ordered position with -0 taken as +0: equal exactly for equal floats.
-    std::uint32_t position_class() const {
-        const auto o = static_cast<std::uint32_t>(bits_ >> 32);
-        return o == kNegativeZero ? kSign : o;
-    }
-    std::uint32_t key() const { return static_cast<std::uint32_t>(bits_); }
-    EventType type() const { return static_cast<EventType>(key() >> 30); }
-    std::uint32_t triangle() const { return key() & kTriangleMask; }
-    friend bool operator<(Event a, Event b) { return a.bits_ < b.bits_; }
-
-    // Greater than every event (their positions are finite): ends a list for a merge without bounds checks.
-    static Event sentinel() {
-        Event e;
-        e.bits_ = ~std::uint64_t{0};
-        return e;
-    }
-
-private:
-    static constexpr std::uint32_t kSign = 1u << 31;
-    static constexpr std::uint32_t kNegativeZero = ~kSign;  // ordered(-0.f)
-    static std::uint32_t ordered(float f) {
-        const auto b = std::bit_cast<std::uint32_t>(f);
-        return b & kSign ? ~b : b | kSign;
-    }
-    std::uint64_t bits_;
-};
-
-struct Ref {
-    std::uint32_t triangle;
-    Box3 box;
-};
-
-// std::nextafter(f, -inf) and std::nextafter(f, +inf), without the library call (which takes a
-// third of the clipping time).
-float float_step_down(float f) {
-    if (f == 0.f) return -std::numeric_limits<float>::denorm_min();
-    if (std::isnan(f) || f == -std::numeric_limits<float>::infinity()) return f;
-    const auto bits = std::bit_cast<std::uint32_t>(f);
-    return std::bit_cast<float>(f > 0.f ? bits - 1 : bits + 1);
-}
-float float_step_up(float f) { return -float_step_down(-f); }
-
-// Rounds a double down / up to the next float, then one more float step outward: the clipped
-// polygon is computed in double, and this keeps its float box conservative.
-float float_below(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = float_step_down(f);
-    return float_step_down(f);
-}
-float float_above(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) < x) f = float_step_up(f);
-    return float_step_up(f);
-}
-
-// A triangle clipped to axis-aligned half-spaces one at a time (Sutherland-Hodgman, in double
-// precision). Cutting a convex polygon by a plane adds at most one vertex: 3 + 6 planes. Each cut
-// writes the new polygon into the other of two buffers rather than copying it back, a copy that
-// would stall on reading vertices just written piecewise.
-class ClippedPolygon {
-public:
-    explicit ClippedPolygon(const Triangle& t) {
-        P* v = buffers_[0];
-        v[0] = {t.v0.x, t.v0.y, t.v0.z};
-        v[1] = {t.v1.x, t.v1.y, t.v1.z};
-        v[2] = {t.v2.x, t.v2.y, t.v2.z};
-    }
-    ClippedPolygon(const ClippedPolygon& other) : n_(other.n_) {
-        std::copy_n(other.buffers_[other.current_], kMaxVertices, buffers_[0]);
-    }
-    ClippedPolygon& operator=(const ClippedPolygon&) = delete;
-
-    // Keeps the part with c[a] >= plane (`keep_above`) or c[a] <= plane.
-    template <bool keep_above>
-    void clip(int a, double plane) {
-        const P* v = buffers_[current_];
-        bool in[kMaxVertices];
-        int inside = 0;
-        for (int i = 0; i < n_; ++i) {
-            in[i] = keep_above ? v[i].c[a] >= plane : v[i].c[a] <= plane;
-            inside += in[i];
-        }
-        if (inside == n_) return;
-        // Every vertex and every edge's crossing point is written, and kept by moving on or not:
-        // which edges cross is unpredictable, and a branch on it costs more than the arithmetic.
-        P* kept = buffers_[current_ ^ 1];
-        int m = 0;
-        for (int i = 0; i < n_; ++i) {
-            const int j = i + 1 == n_ ? 0 : i + 1;
-            const P& cur = v[i];
-            const P& nxt = v[j];
-            kept[m] = cur;
-            m += in[i];
-            const double s = (plane - cur.c[a]) / (nxt.c[a] - cur.c[a]);
-            P& x = kept[m];
-            for (int k = 0; k < 3; ++k) x.c[k] = cur.c[k] + s * (nxt.c[k] - cur.c[k]);
-            x.c[a] = plane;
-            m += in[i] != in[j];
-        }
-        n_ = m;
-        current_ ^= 1;
-    }
-    void clip_to_slab(int a, const Box3& cell) {
-        clip<true>(a, cell.lo[a]);
-        clip<false>(a, cell.hi[a]);
-    }
-
-    // Bounds rounded outward and cut to `cell`; empty when nothing is left.
-    Box3 bounds(const Box3& cell) const {
-        if (n_ == 0) return Box3::empty();
-        const P* v = buffers_[current_];
-        double lo[3], hi[3];
-        for (int k = 0; k < 3; ++k) lo[k] = hi[k] = v[0].c[k];
-        for (int i = 1; i < n_; ++i)
-            for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[i].c[k]), hi[k] = std::max(hi[k], v[i].c[k]);
-        Box3 b;
-        for (int k = 0; k < 3; ++k) {
-            b.lo[k] = std::max(float_below(lo[k]), cell.lo[k]);
-            b.hi[k] = std::min(float_above(hi[k]), cell.hi[k]);
-        }
-        return b;
-    }
-
-private:
-    static constexpr int kMaxVertices = 9;
-    struct P {
-        double c[3];
-    };
-    P buffers_[2][kMaxVertices + 1];  // one spare slot for the last unconditional write
-    int current_ = 0;
-    int n_ = 3;
-};
-
-// Bounds of the parts of `tri` in the two children of `cell` split at `pos` on `axis`: each is the
-// triangle clipped to the child cell's six planes in the order x-lo, x-hi, y-lo, ..., z-hi. The two
-// children share the planes before the split axis, so that prefix is clipped once for both.
-std::pair<Box3, Box3> clipped_child_bounds(const Triangle& tri, const Box3& cell, int axis, float pos) {
-    Box3 lcell = cell, rcell = cell;
-    lcell.hi[axis] = rcell.lo[axis] = pos;
-    ClippedPolygon left(tri);
-    for (int a = 0; a < axis; ++a) left.clip_to_slab(a, cell);
-    ClippedPolygon right = left;
-    left.clip_to_slab(axis, lcell);
-    right.clip_to_slab(axis, rcell);
-    for (int a = axis + 1; a < 3; ++a) {
-        left.clip_to_slab(a, cell);
-        right.clip_to_slab(a, cell);
-    }
-    return {left.bounds(lcell), right.bounds(rcell)};
-}
-
-// The SAH of one candidate split of `cell` (W&H section 3): probabilities are the children's
-// surface areas over the parent's, from two per-axis factors precomputed per cell.
-class SahCost {
-public:
-    SahCost(const Box3& cell, const KdBuildParams& p) : cell_(cell), p_(p) {
-        const double e[3] = {double(cell.hi.x) - cell.lo.x, double(cell.hi.y) - cell.lo.y,
-                             double(cell.hi.z) - cell.lo.z};
-        for (int a = 0; a < 3; ++a) {
-            const double b = e[(a + 1) % 3], c = e[(a + 2) % 3];
-            constant_[a] = b * c;
-            linear_[a] = b + c;
-        }
-        half_area_ = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
-        scaled_reciprocal_ = p.intersection_cost / half_area_;
-    }
-    bool splittable() const { return half_area_ > 0.0; }
-    double leaf(std::size_t n) const { return p_.intersection_cost * static_cast<double>(n); }
-    // Half the surface areas of the two children: the numerators of their probabilities.
-    std::pair<double, double> areas(int a, float pos) const {
-        const double wl = double(pos) - cell_.lo[a], wr = double(cell_.hi[a]) - pos;
-        return {constant_[a] + wl * linear_[a], constant_[a] + wr * linear_[a]};
-    }
-    // Probabilities that a ray through the cell passes through the left and the right child.
-    std::pair<double, double> probabilities(int a, float pos) const {
-        const auto [al, ar] = areas(a, pos);
-        return {al / half_area_, ar / half_area_};
-    }
-    double split(std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr) const {
-        const double pl = areas.first / half_area_, pr = areas.second / half_area_;
-        return with_bonus(p_.traversal_cost + p_.intersection_cost * (pl * double(nl) + pr * double(nr)), nl, nr);
-    }
-    // split() without its two divisions: a multiplication by a reciprocal instead. Each of the two
-    // is at most eight roundings from the real value of the expression, so with nonnegative terms
-    // both lie within a relative 8 * 2^-53 = 2^-50 of it.
-    double estimate(std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr) const {
-        const double weighted = areas.first * double(nl) + areas.second * double(nr);
-        return with_bonus(p_.traversal_cost + scaled_reciprocal_ * weighted, nl, nr);
-    }
-    // Whether every term of split() is nonnegative, so that relative rounding errors do not grow.
-    bool nonnegative() const {
-        return p_.traversal_cost >= 0.0 && p_.intersection_cost >= 0.0 && p_.empty_bonus >= 0.0 && p_.empty_bonus <= 1.0;
-    }
-
-private:
-    double with_bonus(double cost, std::ptrdiff_t nl, std::ptrdiff_t nr) const {
-        return nl == 0 || nr == 0 ? cost * (1.0 - p_.empty_bonus) : cost;
-    }
-
-    Box3 cell_;
-    const KdBuildParams& p_;
-    double constant_[3], linear_[3], half_area_, scaled_reciprocal_;
-};
-
-struct Split {
-    double cost = std::numeric_limits<double>::infinity();
-    int axis = -1;
-    float pos = 0.f;
-    bool planar_left = true;  // where triangles lying in the plane go
-};
-
-// The cheapest of the candidate splits offered; the first of equal costs wins.
-//
-// The exact cost takes two divisions, the sweep's largest expense. So candidates are screened by
-// SahCost::estimate(): it and the exact cost are both within a relative 2^-50 of the real value
-// (all magnitudes come from float extents, far from double underflow and overflow), so a candidate
-// whose estimate is not below best * (1 + 2^-40) costs more than the best and is dropped unseen.
-// The choice is exactly that of costing every candidate exactly.
-class SplitSearch {
-public:
-    explicit SplitSearch(const SahCost& sah) : sah_(sah), screens_(sah.nonnegative()) {}
-
-    // Whether a candidate with this estimate may be cheaper than the best.
-    bool may_improve(double estimate) const { return estimate < bound_; }
-    void offer(int axis, float pos, std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr,
-               bool planar_left) {
-        if (!may_improve(sah_.estimate(areas, nl, nr))) return;
-        const double cost = sah_.split(areas, nl, nr);
-        if (!(cost < best_.cost)) return;
-        best_ = {cost, axis, pos, planar_left};
-        if (screens_) bound_ = cost * (1.0 + 0x1p-40);
-    }
-    const Split& best() const { return best_; }
-
-private:
-    const SahCost& sah_;
-    bool screens_;
-    Split best_;
-    double bound_ = std::numeric_limits<double>::infinity();
-};
 
 // What the builder knows about one node: its cell, its path, and its references either as boxes
 // (binning) or as sorted event lists (sweep). Moved, never copied: `events` may view `owned`.

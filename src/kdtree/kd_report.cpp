@@ -2,7 +2,6 @@
 // often triangles are referenced, and the tree's SAH cost, the expected cost of a random ray that
 // hits the root cell, in the builder's cost units.
 #include <algorithm>
-#include <cstdio>
 
 #include "kd_tree.hpp"
 
@@ -41,33 +40,25 @@ void walk(const KdTree& tree, const KdBuildParams& p, std::uint32_t index, const
     walk(tree, p, n.children() + 1, right, depth + 1, t);
 }
 
-std::string fmt(const char* format, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, format, v);
-    return buf;
-}
-
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> kd_report(const KdTree& tree, const KdBuildParams& p) {
+TreeReport kd_report(const KdTree& tree, const KdBuildParams& p) {
     Totals t;
     walk(tree, p, 0, tree.bounds, 0, t);
     const std::size_t full = t.leaves - t.empty_leaves;
     const double root_area = area(tree.bounds);
-    const char* method = p.method == KdBuildMethod::sweep ? "sweep" : p.method == KdBuildMethod::binned ? "binned" : "hybrid";
-    return {
-        {"method", method},
-        {"nodes", std::to_string(t.inner + t.leaves)},
-        {"inner nodes", std::to_string(t.inner)},
-        {"leaves", std::to_string(t.leaves)},
-        {"empty leaves", std::to_string(t.empty_leaves)},
-        {"depth limit", std::to_string(p.depth_limit(tree.triangle_count))},
-        {"max depth", std::to_string(t.max_depth)},
-        {"mean leaf depth", fmt("%.2f", full ? double(t.depth_sum) / double(full) : 0.0)},
-        {"tris per leaf", fmt("%.2f", full ? double(t.references) / double(full) : 0.0)},
-        {"refs per tri", fmt("%.3f", tree.triangle_count ? double(t.references) / double(tree.triangle_count) : 0.0)},
-        {"SAH cost", fmt("%.2f", root_area > 0.0 ? t.cost / root_area : 0.0)},
-    };
+    TreeReport r;
+    r.nodes = t.inner + t.leaves;
+    r.inner_nodes = t.inner;
+    r.leaves = t.leaves;
+    r.empty_leaves = t.empty_leaves;
+    r.depth_limit = p.depth_limit(tree.triangle_count);
+    r.max_depth = t.max_depth;
+    r.mean_leaf_depth = full ? double(t.depth_sum) / double(full) : 0.0;
+    r.triangles_per_leaf = full ? double(t.references) / double(full) : 0.0;
+    r.references_per_triangle = tree.triangle_count ? double(t.references) / double(tree.triangle_count) : 0.0;
+    r.sah_cost = root_area > 0.0 ? t.cost / root_area : 0.0;
+    return r;
 }
 
 }  // namespace cellrt::detail

@@ -14,10 +14,10 @@
 
 namespace cellrt::detail {
 
-// The last few triangles a ray tested (a "mailbox", Amanatides & Woo 1987; Havran's thesis section
-// 4.5): a kd-tree references a triangle from every leaf it overlaps, and a ray crossing neighbouring
+// The last few triangles a ray tested (the "mailbox" of Amanatides & Woo 1987; Havran's thesis
+// section 4.5; not the study's mailbox dispatch of src/schedule): a kd-tree references a triangle from every leaf it overlaps, and a ray crossing neighbouring
 // leaves would test it again with the same answer.
-struct Mailbox {
+struct RecentTriangles {
     static constexpr int kSize = 8;
     std::uint32_t slot[kSize] = {~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u};
     unsigned next = 0;
@@ -33,15 +33,21 @@ struct Mailbox {
 
 // The kd-tree's hooks for the shared stack traversals (kernel/stack_traversal.hpp): one plane per
 // inner node, which ends the left child's cell and begins the right one's.
-struct KdCells {
+struct KdTraits {
     using Node = KdNode;
     static constexpr int kMaxDepth = kKdMaxDepth;
     static constexpr bool kGaps = false;
+    static constexpr bool kLeafEntriesIndexTriangles = true;
     static float plane(const KdNode& n, std::uint32_t) { return n.split(); }
+    template <class Memory>
+    static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
+        const std::uint32_t prim = mem.index(k);
+        return {mem.triangle(prim), prim};
+    }
 
     // A leaf's entries index the scene's triangles; the mailbox skips those tested in earlier leaves.
     struct Leaves {
-        Mailbox tested;
+        RecentTriangles tested;
 
         template <class Memory, class Query, class Counters>
         bool test(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
@@ -80,7 +86,7 @@ bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Que
     using Point = KdRecPoint;
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
-    KdCells::Leaves leaves;
+    KdTraits::Leaves leaves;
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
     const float reach = r.margin * length(r.dir);
     const Vec3 o = abs(r.org);
@@ -150,10 +156,10 @@ decltype(auto) with_kd_kernel(KdTraversal t, Fn&& fn) {
         return kd_traverse_rec(tree, mem, r, q, c);
     };
     auto branched = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branched<KdCells>(tree, mem, r, q, c);
+        return traverse_branched<KdTraits>(tree, mem, r, q, c);
     };
     auto branchless = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branchless<KdCells>(tree, mem, r, q, c);
+        return traverse_branchless<KdTraits>(tree, mem, r, q, c);
     };
     switch (t) {
         case KdTraversal::rec: return fn(rec);

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
 #include "cellrt/triangle.hpp"
 #include "kd_node.hpp"
@@ -31,7 +32,7 @@ enum class KdBuildMethod { hybrid, sweep, binned };
 inline constexpr double kKdPacketTraversalCost = 45.0;
 
 // Build parameters. Names are those of `-P NAME=VALUE`; defaults and ranges are documented in
-// docs/KDTREE.md and validated in kd_accel.cpp.
+// docs/KDTREE.md and validated by KdStructure::param_table() (kd_structure.cpp).
 struct KdBuildParams {
     // Cost of one traversal step and of one triangle test (Wald & Havran's constants). Trees for
     // SIMD packets default to kKdPacketTraversalCost instead (read_kd_params).
@@ -70,7 +71,7 @@ struct KdTree {
 
 KdTree build_kdtree(std::span<const Triangle> triangles, const KdBuildParams& params);
 
-// Figures of the build report, in print order (Mitsuba's build statistics).
-std::vector<std::pair<std::string, std::string>> kd_report(const KdTree& tree, const KdBuildParams& params);
+// The build report (Mitsuba's build statistics), with the SAH cost in the tree's own cost units.
+TreeReport kd_report(const KdTree& tree, const KdBuildParams& params);
 
 }  // namespace cellrt::detail

@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <span>
 
-#include "cellrt/accel.hpp"
+#include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
 #include "cellrt/ray.hpp"
 #include "cellrt/triangle.hpp"
@@ -152,6 +152,26 @@ struct DirectMemory {
     void touch_node(std::uint32_t) const {}
     std::uint32_t index(std::uint32_t i) const { return indices[i]; }
     const Triangle& triangle(std::uint32_t i) const { return triangles[i]; }
+};
+
+// A triangle of a leaf and its index in the scene: what the traits' leaf_entry() returns.
+struct LeafEntry {
+    const Triangle& triangle;
+    std::uint32_t prim;
+};
+
+// A built tree as its kernels see it: the node array, the leaves' entries, the triangles the entries
+// lead to and the root cell. Every consumer that is not a single-ray kernel over one structure's own
+// types (the SIMD packets, a device copy) reads a tree through this view and the tree's traits.
+template <class Traits>
+struct TreeView {
+    using Node = typename Traits::Node;
+    const Node* nodes;
+    const std::uint32_t* entries;
+    const Triangle* triangles;
+    Box3 bounds;
+
+    DirectMemory<Node> memory() const { return {nodes, entries, triangles}; }
 };
 
 // Runs `fn(counters)` with WorkCounters adding to `*sum`, or with NoCounters when `sum` is null: the

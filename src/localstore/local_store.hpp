@@ -18,7 +18,7 @@
 
 #include "cache_layout.hpp"
 #include "cache_stats.hpp"
-#include "cellrt/accel.hpp"
+#include "cellrt/accelerator.hpp"
 #include "cost_model.hpp"
 
 namespace cellrt {
@@ -66,7 +66,7 @@ struct LocalStoreStats {
     double cycles_per_ray() const { return rays ? static_cast<double>(cycles) / static_cast<double>(rays) : 0.0; }
 };
 
-// A kd-tree or BIH whose traversals run through the local-store model. intersect() and occluded() may
+// A tree whose traversals run through the local-store model (model_accelerator.hpp). intersect() and occluded() may
 // be called concurrently: each calling thread is a worker with a local store of its own, kept from one
 // call to the next as a worker keeps its caches from one packet to the next.
 class LocalStoreAccelerator : public Accelerator {
@@ -81,12 +81,6 @@ public:
                                                                     const std::string& traversal) const = 0;
 };
 
-// Builds `config.kind` ("kd" or "bih", with its build parameters; single-ray kernels) over `triangles`
-// (which must outlive it) to be traced through the model `local_store`. Throws cellrt::Error for
-// another kind, SIMD packets, a bad parameter, an unknown traversal or a configuration the budget
-// refuses.
-std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
-                                                                    const AccelConfig& config,
-                                                                    const LocalStoreConfig& local_store);
+// Built by make_local_store_accelerator() (accel/local_store_registry.hpp) for every tree the registry lists.
 
 }  // namespace cellrt

@@ -1,30 +1,40 @@
-// SIMD ray packets (packet_kernels.inl): the kernels of one instruction set, reached through a table
-// chosen once per accelerator (simd/isa.hpp), never per ray.
+// SIMD ray packets (packet_kernels.inl): the entry points of one instruction set's kernels, for brute
+// force and for every tree, reached through a table chosen once per accelerator, never per ray. The
+// kernels are templates over a tree's traits (kernel/stack_traversal.hpp) and read a tree through its
+// TreeView; the registry (src/accel) compiles them once per instruction set for the structures it lists.
 #pragma once
 
 #include <cstdint>
 #include <span>
+#include <tuple>
 
-#include "bih/bih_tree.hpp"
-#include "cellrt/accel.hpp"
-#include "kdtree/kd_tree.hpp"
-#include "simd/isa.hpp"
+#include "cellrt/accelerator.hpp"
+#include "kernel/traversal.hpp"
 
 namespace cellrt::detail {
 
-struct PacketKernels {
-    int lanes;
-    void (*kd_closest)(const KdTree&, const Triangle*, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
-    void (*kd_any)(const KdTree&, const Triangle*, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
-    void (*bih_closest)(const BihTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
-    void (*bih_any)(const BihTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
-    void (*brute_closest)(std::span<const Triangle>, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
-    void (*brute_any)(std::span<const Triangle>, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+template <class Traits>
+struct TreePacketKernels {
+    void (*closest)(const TreeView<Traits>&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*any)(const TreeView<Traits>&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
 };
 
-const PacketKernels& packet_kernels(Isa isa);
+struct BrutePacketKernels {
+    void (*closest)(std::span<const Triangle>, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*any)(std::span<const Triangle>, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+};
 
-// The kernels `config.simd` asks for; nullptr for "off" (single rays). Throws for an unavailable set.
-const PacketKernels* packet_kernels_for(const AccelConfig& config);
+// One instruction set's kernels for brute force and for the trees of traits `Traits...`.
+template <class... Traits>
+struct PacketTable {
+    int lanes;
+    BrutePacketKernels brute;
+    std::tuple<TreePacketKernels<Traits>...> trees;
+
+    template <class T>
+    const TreePacketKernels<T>& tree() const {
+        return std::get<TreePacketKernels<T>>(trees);
+    }
+};
 
 }  // namespace cellrt::detail

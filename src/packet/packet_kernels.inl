@@ -1,5 +1,8 @@
-// SIMD ray packets: kd-tree, BIH and brute-force kernels that trace kLanes rays at once, one ray per
-// lane, included inside an instruction-set namespace after simd/lanes.inl (see packet_<isa>.cpp).
+// SIMD ray packets: tree and brute-force kernels that trace kLanes rays at once, one ray per lane,
+// included inside an instruction-set namespace after simd/lanes.inl (see accel/packets_<isa>.cpp). The
+// tree kernels are templates over a tree's traits (kernel/stack_traversal.hpp), like the single-ray
+// kernels: a kd-tree node is a BIH node whose two planes coincide, and the traits say where a node's
+// planes are, whether a ray can pass between them, and what a leaf's entries are.
 //
 // Exactness. A lane computes what the single-ray kernels compute for its ray: the same conservative
 // plane tests with the same margin (kernel/traversal.hpp) and the watertight triangle test with the
@@ -294,18 +297,13 @@ inline void split_lanes(const Lanes& L, int a, F t_left_ends, F t_right_starts, 
 // The last lane left in a subtree goes on as a single ray: lane `i` (ray `r`) through the subtree of
 // node `index` with its interval [tmin, tmax] there, by the branched single-ray kernel, which visits
 // what the lane would and tests triangles the same way, at a scalar step's price.
-template <class Tree, class Query>
-[[gnu::noinline]] void trace_single_lane(const Tree& tree, const Triangle* triangles, const TraversalRay& r, int i,
-                                         Query& q, std::uint32_t index, float tmin, float tmax, LaneCounters c) {
+template <class Traits, class Query>
+[[gnu::noinline]] void trace_single_lane(const TreeView<Traits>& tree, const TraversalRay& r, int i, Query& q,
+                                         std::uint32_t index, float tmin, float tmax, LaneCounters c) {
     q.single(i, r, [&](auto& single_query) {
         return c.single([&](auto& counters) {
-            if constexpr (std::is_same_v<Tree, KdTree>) {
-                DirectMemory<KdNode> mem{tree.nodes.data(), tree.indices.data(), triangles};
-                return traverse_branched_from<KdCells>(mem, r, single_query, counters, index, tmin, tmax);
-            } else {
-                DirectMemory<BihNode> mem{tree.nodes.data(), tree.prims.data(), tree.triangles.data()};
-                return traverse_branched_from<BihCells>(mem, r, single_query, counters, index, tmin, tmax);
-            }
+            auto mem = tree.memory();
+            return traverse_branched_from<Traits>(mem, r, single_query, counters, index, tmin, tmax);
         });
     });
 }
@@ -318,22 +316,22 @@ inline bool incoherent(const Lanes& L) {
     return true;
 }
 
-// One packet through a kd-tree or a BIH from `start` (a node whose cell is `start_box`). The two
-// structures differ only in their inner nodes (one plane, or two clip planes) and their leaves
-// (indices into the scene's triangles, or ranges of the BIH's reordered ones).
+// One packet through a tree from `start` (a node whose cell is `start_box`). Trees differ only in what
+// their traits say: their inner nodes' planes (one, or two clip planes with a gap) and their leaves
+// (indices into the scene's triangles, or ranges of the structure's reordered ones).
 //
 // `kHandOver`: whether a lane left alone in a subtree goes on as a single ray (trace_single_lane).
 // Worth it for incoherent lanes, which soon spread over the tree: a scalar step is cheaper than a
 // packet step for one lane. Coherent packets are traced without it: they seldom leave a lane alone
 // for long, and with the call in its loop the kernel ran coherent frames 10 to 20% slower.
-template <bool kHandOver, class Tree, class Query>
-inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes& L, const Ray* rays, Query& q,
-                        std::uint32_t start, const Box3& start_box, LaneCounters c) {
+template <bool kHandOver, class Traits, class Query>
+inline void trace_lanes(const TreeView<Traits>& tree, const Lanes& L, const Ray* rays, Query& q, std::uint32_t start,
+                        const Box3& start_box, LaneCounters c) {
     F tmin, tmax;
     I active = clip_lanes(L, start_box, tmin, tmax);
     if (!any(active)) return;
     // At most two entries per level (see below), plus one.
-    constexpr int kStack = 2 * std::max(kKdMaxDepth, kBihMaxDepth) + 2;
+    constexpr int kStack = 2 * Traits::kMaxDepth + 2;
     LaneEntry stack[kStack];
     int sp = 0;
     std::uint32_t index = start;
@@ -346,7 +344,7 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
                 if (const unsigned b = bits(active); (b & (b - 1)) == 0) {  // one lane left
                     const int i = __builtin_ctz(b);
                     if (!single_rays[i]) single_rays[i].emplace(rays[i], tree.bounds);
-                    trace_single_lane(tree, triangles, *single_rays[i], i, q, index, tmin[i], tmax[i], c);
+                    trace_single_lane(tree, *single_rays[i], i, q, index, tmin[i], tmax[i], c);
                     at_leaf = false;
                     break;
                 }
@@ -355,14 +353,10 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
             const int a = n.axis();
             F lmin, lmax, rmin, rmax;
             I left, right;
-            if constexpr (std::is_same_v<decltype(n), KdNode>) {
-                const F t = (splat(n.split()) - L.org[a]) * L.inv[a];
-                split_lanes(L, a, t, t, tmin, tmax, active, lmin, lmax, rmin, rmax, left, right);
-            } else {
-                const F t_left = (splat(n.clip(0)) - L.org[a]) * L.inv[a];
-                const F t_right = (splat(n.clip(1)) - L.org[a]) * L.inv[a];
-                split_lanes(L, a, t_left, t_right, tmin, tmax, active, lmin, lmax, rmin, rmax, left, right);
-            }
+            const F t_left = (splat(Traits::plane(n, 0)) - L.org[a]) * L.inv[a];
+            F t_right = t_left;
+            if constexpr (Traits::kGaps) t_right = (splat(Traits::plane(n, 1)) - L.org[a]) * L.inv[a];
+            split_lanes(L, a, t_left, t_right, tmin, tmax, active, lmin, lmax, rmin, rmax, left, right);
             const unsigned left_bits = bits(left), right_bits = bits(right);
             const bool go_left = left_bits != 0, go_right = right_bits != 0;
             if (go_left && go_right) {
@@ -395,16 +389,13 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
             n = tree.nodes[index];
         }
         if (at_leaf) {
+            const auto mem = tree.memory();
             c.leaf(active);
             const std::uint32_t end = n.first() + n.count();
             for (std::uint32_t k = n.first(); k < end; ++k) {
                 c.triangle(active);
-                if constexpr (std::is_same_v<decltype(n), KdNode>) {
-                    const std::uint32_t prim = tree.indices[k];
-                    q.test(L, triangles[prim], prim, active);
-                } else {
-                    q.test(L, tree.triangles[k], tree.prims[k], active);
-                }
+                const LeafEntry e = Traits::leaf_entry(mem, k);
+                q.test(L, e.triangle, e.prim, active);
                 if constexpr (Query::kAnyHit) {
                     active &= ~q.finished();
                     if (!any(active)) break;
@@ -427,11 +418,10 @@ inline void trace_lanes(const Tree& tree, const Triangle* triangles, const Lanes
 
 // The incoherent instantiation out of line, so that the coherent one's caller is compiled as if it
 // were the only one.
-template <class Tree, class Query>
-[[gnu::noinline]] void trace_incoherent_lanes(const Tree& tree, const Triangle* triangles, const Lanes& L,
-                                              const Ray* rays, Query& q, std::uint32_t start, const Box3& start_box,
-                                              LaneCounters c) {
-    trace_lanes<true>(tree, triangles, L, rays, q, start, start_box, c);
+template <class Traits, class Query>
+[[gnu::noinline]] void trace_incoherent_lanes(const TreeView<Traits>& tree, const Lanes& L, const Ray* rays, Query& q,
+                                              std::uint32_t start, const Box3& start_box, LaneCounters c) {
+    trace_lanes<true>(tree, L, rays, q, start, start_box, c);
 }
 
 inline float min_of(F x) {
@@ -448,8 +438,8 @@ inline float max_of(F x) {
 // Entry-point search for a whole batch (see the top of this file). Returns the deepest node whose
 // cell contains every ray's traversal, and sets `box` to that cell; the root when the batch is not
 // coherent (invalid rays, mixed direction signs or zero direction components).
-template <class Tree>
-inline std::uint32_t entry_point(const Tree& tree, std::span<const Lanes> groups, Box3& box) {
+template <class Traits>
+inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const Lanes> groups, Box3& box) {
     box = tree.bounds;
     const F inf = splat(kInfinity);
     F olo[3] = {inf, inf, inf}, ohi[3] = {-inf, -inf, -inf}, ilo[3] = {inf, inf, inf}, ihi[3] = {-inf, -inf, -inf};
@@ -498,22 +488,16 @@ inline std::uint32_t entry_point(const Tree& tree, std::span<const Lanes> groups
             hi = std::max(std::max(p[0], p[1]), std::max(p[2], p[3]));
         };
         float l_lo, l_hi, r_lo, r_hi;
-        if constexpr (std::is_same_v<std::decay_t<decltype(n)>, KdNode>) {
-            range(n.split(), l_lo, l_hi);
-            r_lo = l_lo, r_hi = l_hi;
-        } else {
-            range(n.clip(0), l_lo, l_hi);
-            range(n.clip(1), r_lo, r_hi);
-        }
+        range(Traits::plane(n, 0), l_lo, l_hi);
+        r_lo = l_lo, r_hi = l_hi;
+        if constexpr (Traits::kGaps) range(Traits::plane(n, 1), r_lo, r_hi);
         const bool negative_dir = (signs >> a) & 1u;
         // Near child ends at its plane, far child starts at its plane (as in split_lanes).
         const float near_end_hi = negative_dir ? r_hi : l_hi, far_start_lo = negative_dir ? l_lo : r_lo;
         const bool near_needed = !(tmin > near_end_hi + margin), far_needed = !(far_start_lo - margin > tmax);
         if (near_needed == far_needed) return index;  // the batch splits here (or passes between planes)
         const bool left = negative_dir ? far_needed : near_needed;
-        float plane;
-        if constexpr (std::is_same_v<std::decay_t<decltype(n)>, KdNode>) plane = n.split();
-        else plane = left ? n.clip(0) : n.clip(1);
+        const float plane = Traits::plane(n, left ? 0u : 1u);
         if (left) box.hi[a] = std::min(box.hi[a], plane);
         else box.lo[a] = std::max(box.lo[a], plane);
         if (far_needed) tmin = std::max(tmin, far_start_lo - margin);
@@ -525,9 +509,10 @@ inline std::uint32_t entry_point(const Tree& tree, std::span<const Lanes> groups
 // when there is more than one packet, then each packet from the entry point.
 constexpr std::size_t kGroups = 64;
 
-template <class Tree, class Query, class Out>
-inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<const Ray> rays, Out* out,
-                        TraversalCounters* counters) {
+template <class Traits, class Query, class Out>
+void trace_batch(const TreeView<Traits>& tree, std::span<const Ray> rays, std::span<Out> results,
+                 TraversalCounters* counters) {
+    Out* out = results.data();
     Lanes groups[kGroups];
     for (std::size_t begin = 0; begin < rays.size(); begin += kGroups * kLanes) {
         const std::size_t end = std::min(rays.size(), begin + kGroups * kLanes);
@@ -541,9 +526,9 @@ inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<c
             Query q(groups[g]);
             const Ray* group_rays = rays.data() + begin + g * kLanes;
             if (incoherent(groups[g]))
-                trace_incoherent_lanes(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
+                trace_incoherent_lanes(tree, groups[g], group_rays, q, start, box, LaneCounters{counters});
             else
-                trace_lanes<false>(tree, triangles, groups[g], group_rays, q, start, box, LaneCounters{counters});
+                trace_lanes<false>(tree, groups[g], group_rays, q, start, box, LaneCounters{counters});
             q.store(groups[g], out + begin + g * kLanes);
         }
     }
@@ -552,8 +537,9 @@ inline void trace_batch(const Tree& tree, const Triangle* triangles, std::span<c
 
 // Brute force, kLanes rays at a time: every triangle against every lane.
 template <class Query, class Out>
-inline void brute_batch(std::span<const Triangle> triangles, std::span<const Ray> rays, Out* out,
-                        TraversalCounters* counters) {
+void brute_batch(std::span<const Triangle> triangles, std::span<const Ray> rays, std::span<Out> results,
+                 TraversalCounters* counters) {
+    Out* out = results.data();
     Box3 bounds;
     for (const Triangle& t : triangles) bounds.extend(t.bounds());
     for (std::size_t i = 0; i < rays.size(); i += kLanes) {
@@ -571,26 +557,12 @@ inline void brute_batch(std::span<const Triangle> triangles, std::span<const Ray
     if (counters) counters->rays += rays.size();
 }
 
-inline const PacketKernels& kernels() {
-    static const PacketKernels k{
-        kLanes,
-        [](const KdTree& t, const Triangle* tris, std::span<const Ray> r, std::span<Hit> h, TraversalCounters* c) {
-            trace_batch<KdTree, ClosestLanes>(t, tris, r, h.data(), c);
-        },
-        [](const KdTree& t, const Triangle* tris, std::span<const Ray> r, std::span<std::uint8_t> o,
-           TraversalCounters* c) { trace_batch<KdTree, AnyLanes>(t, tris, r, o.data(), c); },
-        [](const BihTree& t, std::span<const Ray> r, std::span<Hit> h, TraversalCounters* c) {
-            trace_batch<BihTree, ClosestLanes>(t, nullptr, r, h.data(), c);
-        },
-        [](const BihTree& t, std::span<const Ray> r, std::span<std::uint8_t> o, TraversalCounters* c) {
-            trace_batch<BihTree, AnyLanes>(t, nullptr, r, o.data(), c);
-        },
-        [](std::span<const Triangle> tris, std::span<const Ray> r, std::span<Hit> h, TraversalCounters* c) {
-            brute_batch<ClosestLanes>(tris, r, h.data(), c);
-        },
-        [](std::span<const Triangle> tris, std::span<const Ray> r, std::span<std::uint8_t> o, TraversalCounters* c) {
-            brute_batch<AnyLanes>(tris, r, o.data(), c);
-        },
-    };
-    return k;
+// This instruction set's table for brute force and the trees of traits `Traits...` (the registry's
+// structures): instantiated here, inside the instruction set's target region and namespace.
+template <class... Traits>
+PacketTable<Traits...> make_packet_table() {
+    return {kLanes,
+            {&brute_batch<ClosestLanes, Hit>, &brute_batch<AnyLanes, std::uint8_t>},
+            {TreePacketKernels<Traits>{&trace_batch<Traits, ClosestLanes, Hit>,
+                                       &trace_batch<Traits, AnyLanes, std::uint8_t>}...}};
 }

@@ -1,33 +1,26 @@
-// The kd-tree and the BIH traced through the local-store model: the structure is built as for direct
-// memory, its arrays are mapped into the model's main memory, and every worker thread runs the
-// structure's own kernels (kd_traversal.hpp, bih_traversal.hpp) over CachedMemory and its own
-// local store, packet by packet.
+// A tree traced through the local-store model: the structure is built as for direct memory, its
+// arrays are mapped into the model's main memory, and every worker thread runs the structure's own
+// kernels over CachedMemory and its own local store, packet by packet. A template over the
+// structure's descriptor (kdtree/kd_structure.hpp), which the registry instantiates for every tree it
+// lists (accel/local_store_registry.cpp); the local store holds the stack the descriptor declares for
+// the traversal (stack_bytes).
+#pragma once
+
 #include <algorithm>
+#include <memory>
 #include <type_traits>
 #include <utility>
 
 #include <tbb/enumerable_thread_specific.h>
 
-#include "kernel/traversal.hpp"
-#include "bih/bih_accel.hpp"
 #include "cached_memory.hpp"
-#include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
-#include "kdtree/kd_accel.hpp"
+#include "kernel/named.hpp"
+#include "kernel/param_reader.hpp"
+#include "kernel/traversal.hpp"
 #include "local_store.hpp"
 
-namespace cellrt {
-namespace detail {
-namespace {
-
-// The kernels' stacks as they declare them, which the local store must hold: TA_rec's points on the
-// ray, the others' (node, tmin, tmax) entries (the branchless kernel's stack, one entry larger than
-// the branched one's).
-std::size_t stack_bytes(KdTraversal t) {
-    if (t == KdTraversal::rec) return kKdRecStackSize * sizeof(KdRecPoint);
-    return kBranchlessStackSize<KdCells> * sizeof(StackEntry);
-}
-std::size_t stack_bytes(BihTraversal) { return kBranchlessStackSize<BihCells> * sizeof(StackEntry); }
+namespace cellrt::detail {
 
 // A built structure and its image in the model's main memory, shared by every configuration traced over it.
 template <class S>
@@ -76,13 +69,6 @@ struct ModelCounters {
     }
 };
 
-std::string validated_traversal(const char* structure, const std::vector<std::string>& names,
-                                const std::string& traversal) {
-    AccelConfig c;
-    c.traversal = traversal;
-    return traversal_or_default(c, names, structure);
-}
-
 template <class S>
 class ModelAccelerator final : public LocalStoreAccelerator {
 public:
@@ -92,9 +78,9 @@ public:
                      const std::string& traversal)
         : built_(std::move(built)),
           config_(config),
-          traversal_name_(validated_traversal(S::kName, S::traversal_names(), traversal)),
-          traversal_(S::traversal(traversal_name_)),
-          allocations_(allocate_local_store(config, stack_bytes(traversal_))),
+          traversal_name_(choose_traversal(names_of(S::kTraversals), traversal, S::kName)),
+          traversal_(value_named(S::kTraversals, traversal_name_, "traversal")),
+          allocations_(allocate_local_store(config, S::stack_bytes(traversal_))),
           workers_([this] { return WorkerStore(config_, built_->memory); }) {}
 
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
@@ -112,13 +98,20 @@ public:
 
     AccelStats stats() const override {
         const LocalStoreConfig& c = config_;
-        AccelStats s{S::kName, built_->build_seconds, built_->structure.memory_bytes(),
-                     {{"traversal", traversal_name_},
-                      {"local store", std::to_string(c.budget_bytes / 1024) + " KiB, node cache " +
-                                          c.node_cache.to_string() + ", triangle cache " +
-                                          c.triangle_cache.to_string() + ", " + to_string(c.access) +
-                                          (c.access == CacheAccess::async && !c.retouch ? " without re-touch" : "")}}};
-        for (auto& f : built_->structure.report()) s.figures.push_back(std::move(f));
+        const S& structure = built_->structure;
+        AccelStats s;
+        s.name = S::kName;
+        s.traversal = traversal_name_;
+        s.build_seconds = built_->build_seconds;
+        s.memory_bytes = structure.memory_bytes();
+        s.triangles = structure.triangle_array().size();
+        s.tree = structure.report();
+        s.settings = structure.settings();
+        s.settings.emplace_back("local store", std::to_string(c.budget_bytes / 1024) + " KiB, node cache " +
+                                                   c.node_cache.to_string() + ", triangle cache " +
+                                                   c.triangle_cache.to_string() + ", " + to_string(c.access) +
+                                                   (c.access == CacheAccess::async && !c.retouch ? " without re-touch"
+                                                                                                   : ""));
         return s;
     }
 
@@ -178,30 +171,15 @@ private:
     mutable tbb::enumerable_thread_specific<WorkerStore> workers_;
 };
 
+// Builds S over `triangles` for the model `local_store`. A bad traversal or configuration is refused
+// before time is spent on the build.
 template <class S>
 std::unique_ptr<LocalStoreAccelerator> make_model(std::span<const Triangle> triangles, const AccelConfig& config,
                                                   const LocalStoreConfig& local_store) {
-    // Refuse a bad traversal or configuration before spending time on the build.
-    const std::string traversal = validated_traversal(S::kName, S::traversal_names(), config.traversal);
-    allocate_local_store(local_store, stack_bytes(S::traversal(traversal)));
+    const std::string traversal = choose_traversal(names_of(S::kTraversals), config.traversal, S::kName);
+    allocate_local_store(local_store, S::stack_bytes(value_named(S::kTraversals, traversal, "traversal")));
     auto built = std::make_shared<const Built<S>>(triangles, config);
     return std::make_unique<ModelAccelerator<S>>(std::move(built), local_store, traversal);
 }
 
-}  // namespace
-}  // namespace detail
-
-std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
-                                                                    const AccelConfig& config,
-                                                                    const LocalStoreConfig& local_store) {
-    if (config.kind != "kd" && config.kind != "bih")
-        throw Error("the local-store model runs the kd-tree and the BIH (--accel kd or bih), not '" + config.kind +
-                    "'");
-    if (config.simd != "off")
-        throw Error("the local-store model runs the single-ray kernels, not SIMD packets (simd '" + config.simd +
-                    "'; use off)");
-    if (config.kind == "kd") return detail::make_model<detail::KdStructure>(triangles, config, local_store);
-    return detail::make_model<detail::BihStructure>(triangles, config, local_store);
-}
-
-}  // namespace cellrt
+}  // namespace cellrt::detail

@@ -1,5 +1,6 @@
-// The packet kernels compiled for sse (4 lanes), in a target region and a namespace of their own.
-#include "packet_isa.hpp"
+// The packet kernels of every listed structure compiled for sse (4 lanes), in a target region and a
+// namespace of their own.
+#include "accel/packet_isa.hpp"
 
 #if defined(__x86_64__)
 #pragma GCC push_options
@@ -8,7 +9,8 @@ namespace cellrt::detail::isa_sse {
 constexpr int kLanes = 4;
 #define CELLRT_SIMD_SSE
 #include "simd/lanes.inl"
-#include "packet_kernels.inl"
+#include "packet/packet_kernels.inl"
+#include "accel/packet_table.inl"
 #undef CELLRT_SIMD_SSE
 }  // namespace cellrt::detail::isa_sse
 #pragma GCC pop_options

@@ -1,4 +1,4 @@
-// What every instruction set's translation unit (packet_<isa>.cpp) includes before it opens its
+// What every instruction set's translation unit (packets_<isa>.cpp) includes before it opens its
 // target region and namespace: everything the kernels use from outside, so that nothing included
 // inside the region is compiled for that instruction set except the kernels themselves.
 #pragma once
@@ -16,10 +16,10 @@
 #include <immintrin.h>
 #endif
 
+#include "accel/packet_table.hpp"
+#include "accel/structures.hpp"
+#include "kernel/stack_traversal.hpp"
 #include "kernel/traversal.hpp"
-#include "bih/bih_traversal.hpp"
-#include "kdtree/kd_traversal.hpp"
-#include "packet.hpp"
 
 namespace cellrt::detail {
 const PacketKernels& packet_kernels_portable();

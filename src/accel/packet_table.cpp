@@ -1,4 +1,4 @@
-#include "packet_isa.hpp"
+#include "accel/packet_isa.hpp"
 
 namespace cellrt::detail {
 

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""A/B of two builds of cellrt_bench on the same rays: runs A and B alternately (A B B A A B ...), each
+run a full `cellrt_bench --json`, and prints per scene and configuration the median time of B over
+the median time of A (primary and shadow rays, and both). Interleaving whole runs spreads a noisy
+machine's slow spells over both builds; the Embree configurations, the same code in both, show how
+much noise is left.
+
+    bench/ab_compare.py OLD/cellrt_bench NEW/cellrt_bench --rounds 4 --json out.json -- [cellrt_bench options]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def run(binary, args):
+    with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as f:
+        path = f.name
+    try:
+        subprocess.run([binary, *args, "--json", path], check=True, stdout=subprocess.DEVNULL)
+        with open(path) as f:
+            return json.load(f)
+    finally:
+        os.unlink(path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("a")
+    ap.add_argument("b")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--json", help="write every run's rows and the ratios here")
+    ap.add_argument("bench_args", nargs=argparse.REMAINDER)
+    o = ap.parse_args()
+    args = o.bench_args[1:] if o.bench_args[:1] == ["--"] else o.bench_args
+    times = {"a": {}, "b": {}}
+    runs = []
+    for r in range(o.rounds):
+        for side in ("ab" if r % 2 == 0 else "ba"):
+            rows = run(o.a if side == "a" else o.b, args)
+            runs.append({"side": side, "round": r, "rows": rows})
+            for row in rows:
+                key = (row["scene"], row["config"])
+                times[side].setdefault(key, []).append((row["primary_seconds"], row["shadow_seconds"]))
+            print(f"round {r + 1}/{o.rounds}: {side} done", file=sys.stderr)
+    result = []
+    print("| scene | config | primary B/A | shadow B/A | total B/A |\n|---|---|---|---|---|")
+    for key in times["a"]:
+        if key not in times["b"]:
+            continue
+        med = {s: [statistics.median(t[i] for t in times[s][key]) for i in (0, 1)] for s in ("a", "b")}
+        p, sh = med["b"][0] / med["a"][0], med["b"][1] / med["a"][1]
+        tot = sum(med["b"]) / sum(med["a"])
+        result.append({"scene": key[0], "config": key[1], "primary": p, "shadow": sh, "total": tot})
+        print(f"| {key[0]} | {key[1]} | {p:.3f} | {sh:.3f} | {tot:.3f} |")
+    if o.json:
+        with open(o.json, "w") as f:
+            json.dump({"args": args, "rounds": o.rounds, "ratios": result, "runs": runs}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

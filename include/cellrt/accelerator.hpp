@@ -1,0 +1,93 @@
+// The accelerator interface: what every acceleration structure (brute force, kd-tree, BIH, Embree)
+// offers the renderer, the scheduler, the bindings and the tests. Calls take a batch of rays (a packet
+// or a tile), so the one virtual dispatch is paid per batch, never per ray. The structures and their
+// registry are in cellrt/accel.hpp.
+//
+// Thread safety: intersect() and occluded() are const and may run concurrently on one accelerator.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cellrt/ray.hpp"
+#include "cellrt/triangle.hpp"
+
+namespace cellrt {
+
+// Per-query work counters, summed over a batch when requested (pass a non-null pointer).
+struct TraversalCounters {
+    std::uint64_t rays = 0;
+    std::uint64_t nodes = 0;      // inner nodes visited
+    std::uint64_t leaves = 0;     // leaves visited (brute force: 0)
+    std::uint64_t triangles = 0;  // ray-triangle tests
+
+    TraversalCounters& operator+=(const TraversalCounters& o) {
+        rays += o.rays; nodes += o.nodes; leaves += o.leaves; triangles += o.triangles;
+        return *this;
+    }
+};
+
+struct AccelConfig {
+    std::string kind = "kd";   // see accelerator_kinds()
+    std::string traversal;     // empty: the structure's default
+    // SIMD packet kernels: "off" (one ray at a time, with `traversal`), "auto" (the best instruction
+    // set this binary and processor have), "portable", "sse", "avx2" or "avx512". With packets, each
+    // batch is traced kLanes rays at a time (4, 8 or 16), large batches after an entry-point search.
+    std::string simd = "off";
+    unsigned threads = 0;      // build threads; 0: all hardware threads
+    std::map<std::string, std::string> params;  // the structure's build parameters (its ParamTable)
+};
+
+// A tree's build report (Mitsuba's build statistics): its shape, how often triangles are referenced,
+// and its SAH cost, the expected cost of a random ray that meets the root cell, in the kd-tree's
+// default cost units (so that the kd-tree's and the BIH's compare).
+struct TreeReport {
+    std::size_t nodes = 0, inner_nodes = 0, leaves = 0, empty_leaves = 0;
+    std::optional<std::size_t> empty_space_nodes;  // BIH: inner nodes that cut off empty space
+    int depth_limit = 0, max_depth = 0;
+    double mean_leaf_depth = 0.0;          // over non-empty leaves
+    double triangles_per_leaf = 0.0;       // over non-empty leaves
+    double references_per_triangle = 0.0;  // leaf entries per scene triangle
+    double sah_cost = 0.0;
+};
+
+// What a built accelerator reports: typed figures for code, and figures() for people.
+struct AccelStats {
+    std::string name;             // the kind
+    std::string traversal;        // the single-ray kernel, "packet" (SIMD packets), or Embree's
+    int simd_lanes = 0;           // rays a SIMD packet traces at once; 0: single rays
+    double build_seconds = 0.0;
+    std::size_t memory_bytes = 0;
+    std::size_t triangles = 0;
+    std::optional<TreeReport> tree;  // kd-tree and BIH
+    // The build settings as used (name, value), in print order: the structure's parameters that shape
+    // its build, Embree's flags, the local store's layout.
+    std::vector<std::pair<std::string, std::string>> settings;
+
+    // The printed report, in print order: every field above as (name, value).
+    std::vector<std::pair<std::string, std::string>> figures() const;
+    // The value of setting `name`, or nullopt.
+    std::optional<std::string> setting(const std::string& name) const;
+};
+
+class Accelerator {
+public:
+    virtual ~Accelerator() = default;
+
+    // Closest hit of each ray under the hit rule of ray.hpp; hits.size() must equal rays.size().
+    virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits,
+                           TraversalCounters* counters = nullptr) const = 0;
+
+    // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0.
+    virtual void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                          TraversalCounters* counters = nullptr) const = 0;
+
+    virtual AccelStats stats() const = 0;
+};
+
+}  // namespace cellrt

@@ -1,0 +1,46 @@
+// Reads a structure's build parameters from an AccelConfig against its ParamTable (cellrt/params.hpp):
+// defaults and ranges come from the table alone, so the table that validates is the table users list
+// and the documents print.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cellrt/accelerator.hpp"
+#include "cellrt/params.hpp"
+
+namespace cellrt::detail {
+
+class ParamReader {
+public:
+    // Throws cellrt::Error naming `structure` for a parameter of `config` that `table` lacks.
+    ParamReader(const ParamTable& table, const AccelConfig& config, std::string structure);
+
+    // The parameter's value, or its default (`default_value` in place of the table's where given: a
+    // default that depends on another option). Throws cellrt::Error for a malformed or out-of-range value.
+    double number(const std::string& name, const std::string* default_value = nullptr);
+    int integer(const std::string& name);
+    bool boolean(const std::string& name);
+    std::string choice(const std::string& name);
+
+    // Call after reading: a row of the table that was never read is a programming error of the
+    // structure (its table would promise a parameter that changes nothing); throws std::logic_error.
+    void finish() const;
+
+private:
+    const ParamSpec& spec(const std::string& name, ParamType type) const;
+    const std::string& text(const ParamSpec& spec, const std::string* default_value) const;
+
+    const ParamTable& table_;
+    std::map<std::string, std::string> given_;
+    std::string structure_;
+    mutable std::vector<std::string> read_;
+};
+
+// The traversal `requested` among `names` (the default first), or the default when `requested` is
+// empty. Throws cellrt::Error naming `structure` for one it does not offer.
+std::string choose_traversal(const std::vector<std::string>& names, const std::string& requested,
+                             const std::string& structure);
+
+}  // namespace cellrt::detail

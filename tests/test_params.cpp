@@ -1,0 +1,137 @@
+// Every structure's parameter table: it validates, it is what the documents print, and every value it
+// calls a default is one it accepts.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
+
+namespace cellrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kDocs = fs::path(CELLRT_TEST_DATA).parent_path().parent_path() / "docs";
+
+const std::vector<Triangle>& small_scene() {
+    static const Scene scene = load_scene("builtin:spheres?tris=400");
+    return scene.triangles;
+}
+
+std::string read_text(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// The text between <!-- params:KIND --> and <!-- /params --> in `doc`, without the surrounding newlines.
+std::string documented_table(const std::string& doc, const std::string& kind) {
+    const std::string open = "<!-- params:" + kind + " -->\n";
+    const auto b = doc.find(open);
+    if (b == std::string::npos) return "(no table marked " + open + ")";
+    const auto e = doc.find("<!-- /params -->", b);
+    return doc.substr(b + open.size(), e - b - open.size());
+}
+
+// The documents' tables are the code's tables, row for row (`cellrt info --params KIND` prints the
+// same; rewrite a document's table from it when a parameter changes).
+TEST(Params, DocumentsPrintTheTablesThatValidate) {
+    std::vector<std::pair<std::string, std::string>> docs{{"kd", "KDTREE.md"}, {"bih", "BIH.md"}};
+    const auto kinds = accelerator_kinds();
+    if (std::find(kinds.begin(), kinds.end(), "embree") != kinds.end()) docs.emplace_back("embree", "EMBREE.md");
+    for (const auto& [kind, file] : docs)
+        EXPECT_EQ(documented_table(read_text(kDocs / file), kind), param_table_markdown(accelerator_params(kind)))
+            << "docs/" << file << " against the table of " << kind;
+}
+
+// Every default the tables print is accepted as a user's value, and giving every parameter at its
+// default builds the tree that giving none does.
+TEST(Params, DefaultsAreValidValuesAndTheBuildsDefaults) {
+    for (const std::string& kind : accelerator_kinds()) {
+        AccelConfig plain;
+        plain.kind = kind;
+        plain.threads = 1;
+        AccelConfig spelled = plain;
+        for (const ParamSpec& p : accelerator_params(kind)) spelled.params[p.name] = p.default_value;
+        std::unique_ptr<Accelerator> a, b;
+        ASSERT_NO_THROW(a = make_accelerator(small_scene(), plain)) << kind;
+        ASSERT_NO_THROW(b = make_accelerator(small_scene(), spelled)) << kind;
+        const AccelStats sa = a->stats(), sb = b->stats();
+        EXPECT_EQ(sa.memory_bytes != 0, sb.memory_bytes != 0) << kind;
+        if (sa.tree) {
+            ASSERT_TRUE(sb.tree) << kind;
+            EXPECT_EQ(sa.tree->nodes, sb.tree->nodes) << kind;
+            EXPECT_EQ(sa.tree->sah_cost, sb.tree->sah_cost) << kind;
+        }
+    }
+}
+
+// Unknown names, values beyond a range, and unknown kinds or traversals are refused everywhere, with
+// the structure and the parameter named.
+TEST(Params, UnknownNamesAndValuesOutOfRangeAreRefused) {
+    for (const std::string& kind : accelerator_kinds()) {
+        AccelConfig c;
+        c.kind = kind;
+        c.params = {{"no_such_parameter", "1"}};
+        try {
+            make_accelerator(small_scene(), c);
+            ADD_FAILURE() << kind << " accepted an unknown parameter";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("no_such_parameter"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(kind), std::string::npos) << e.what();
+        }
+        c.params.clear();
+        c.traversal = "no_such_traversal";
+        EXPECT_THROW(make_accelerator(small_scene(), c), Error) << kind;
+        for (const ParamSpec& p : accelerator_params(kind)) {
+            std::vector<std::string> bad{"", "x1"};
+            if (p.type == ParamType::number || p.type == ParamType::integer) {
+                char below[64], above[64];
+                std::snprintf(below, sizeof below, "%.17g", p.min - 1.0);
+                std::snprintf(above, sizeof above, "%.17g", p.max * 2.0 + 1.0);
+                bad.insert(bad.end(), {below, above});
+            }
+            for (const std::string& v : bad) {
+                AccelConfig b;
+                b.kind = kind;
+                b.params = {{p.name, v}};
+                EXPECT_THROW(make_accelerator(small_scene(), b), Error) << kind << " " << p.name << "='" << v << "'";
+            }
+        }
+    }
+    EXPECT_THROW(accelerator_params("octree"), Error);
+    EXPECT_THROW(accelerator_traversals("octree"), Error);
+    EXPECT_THROW(make_accelerator(small_scene(), AccelConfig{"octree"}), Error);
+}
+
+TEST(Params, TablesListEveryTraversalTheStructuresOffer) {
+    EXPECT_EQ(accelerator_traversals("kd"), (std::vector<std::string>{"branched", "rec", "branchless"}));
+    EXPECT_EQ(accelerator_traversals("bih"), (std::vector<std::string>{"branched", "branchless"}));
+    for (const std::string& kind : accelerator_kinds())
+        for (const std::string& t : accelerator_traversals(kind)) {
+            AccelConfig c;
+            c.kind = kind;
+            c.traversal = t;
+            EXPECT_NO_THROW(make_accelerator(small_scene(), c)) << kind << ":" << t;
+        }
+}
+
+// The SAH BIH's costs are parameters: with triangle tests made dearer against node visits, the SAH
+// splits further, into more nodes.
+TEST(Params, BihSahCostsShapeTheTree) {
+    auto nodes = [](const std::string& intersection) {
+        AccelConfig c = parse_accel_config("bih@split=sah,intersection_cost=" + intersection);
+        return make_accelerator(small_scene(), c)->stats().tree.value().nodes;
+    };
+    EXPECT_LT(nodes("1"), nodes("1000"));
+}
+
+}  // namespace
+}  // namespace cellrt
