@@ -8,6 +8,7 @@
 #include "accel/local_store_registry.hpp"
 #include "accel/structures.hpp"
 #include "accel/tree_accelerator.hpp"
+#include "accel/brute_force_listing.hpp"
 #include "cellrt/brute_force.hpp"
 #include "cellrt/error.hpp"
 #include "kernel/named.hpp"

@@ -1,3 +1,4 @@
+#include "accel/brute_force_listing.hpp"
 #include "cellrt/brute_force.hpp"
 
 #include "cellrt/timer.hpp"

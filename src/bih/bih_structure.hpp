@@ -10,6 +10,7 @@
 #include "cellrt/accelerator.hpp"
 #include "cellrt/params.hpp"
 #include "kernel/named.hpp"
+#include "kernel/tree_report.hpp"
 
 namespace cellrt::detail {
 
@@ -18,6 +19,7 @@ BihBuildParams read_bih_params(const AccelConfig& config);
 
 // The BIH keeps its own reordered copy of the triangles.
 struct BihStructure {
+    static constexpr double kReportTraversalCost = 15.0, kReportIntersectionCost = 20.0;
     using Traits = BihTraits;
     using Node = BihNode;
     using Traversal = BihTraversal;
@@ -44,7 +46,12 @@ struct BihStructure {
     std::size_t memory_bytes() const {
         return nodes().size_bytes() + entries().size_bytes() + triangle_array().size_bytes();
     }
-    TreeReport report() const { return bih_report(tree, params); }
+    // The SAH cost in the kd-tree's default cost units whatever the build used, so that the two
+    // structures' reports compare.
+    TreeReport report() const {
+        return tree_report(view(), {kReportTraversalCost, kReportIntersectionCost}, params.max_depth,
+                           tree.triangles.size());
+    }
     std::vector<std::pair<std::string, std::string>> settings() const;
 
     BihBuildParams params;

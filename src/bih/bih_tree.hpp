@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "bih_node.hpp"
-#include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
 #include "cellrt/triangle.hpp"
 
@@ -52,8 +51,5 @@ struct BihTree {
 };
 
 BihTree build_bih(std::span<const Triangle> triangles, const BihBuildParams& params);
-
-// The build report (bih_report.cpp).
-TreeReport bih_report(const BihTree& tree, const BihBuildParams& params);
 
 }  // namespace cellrt::detail

@@ -22,6 +22,7 @@
 #include "cellrt/params.hpp"
 #include "kd_traversal.hpp"
 #include "kernel/named.hpp"
+#include "kernel/tree_report.hpp"
 
 namespace cellrt::detail {
 
@@ -56,7 +57,11 @@ struct KdStructure {
     std::span<const Triangle> triangle_array() const { return triangles; }
     TreeView<KdTraits> view() const { return {tree.nodes.data(), tree.indices.data(), triangles.data(), tree.bounds}; }
     std::size_t memory_bytes() const { return nodes().size_bytes() + entries().size_bytes(); }
-    TreeReport report() const { return kd_report(tree, params); }
+    // The SAH cost in the tree's own cost units.
+    TreeReport report() const {
+        return tree_report(view(), {params.traversal_cost, params.intersection_cost},
+                           params.depth_limit(tree.triangle_count), tree.triangle_count);
+    }
     std::vector<std::pair<std::string, std::string>> settings() const;
 
     KdBuildParams params;

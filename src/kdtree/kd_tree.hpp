@@ -14,7 +14,6 @@
 #include <utility>
 #include <vector>
 
-#include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
 #include "cellrt/triangle.hpp"
 #include "kd_node.hpp"
@@ -70,8 +69,5 @@ struct KdTree {
 };
 
 KdTree build_kdtree(std::span<const Triangle> triangles, const KdBuildParams& params);
-
-// The build report (Mitsuba's build statistics), with the SAH cost in the tree's own cost units.
-TreeReport kd_report(const KdTree& tree, const KdBuildParams& params);
 
 }  // namespace cellrt::detail
