@@ -33,9 +33,10 @@ def main():
     ap.add_argument("b")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--json", help="write every run's rows and the ratios here")
-    ap.add_argument("bench_args", nargs=argparse.REMAINDER)
-    o = ap.parse_args()
-    args = o.bench_args[1:] if o.bench_args[:1] == ["--"] else o.bench_args
+    argv = sys.argv[1:]
+    split = argv.index("--") if "--" in argv else len(argv)
+    o = ap.parse_args(argv[:split])
+    args = argv[split + 1:]
     times = {"a": {}, "b": {}}
     runs = []
     for r in range(o.rounds):
