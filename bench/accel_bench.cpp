@@ -18,50 +18,32 @@
 
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
-#include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
-#include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
-#include "cellrt/schedule.hpp"
 #include "cellrt/timer.hpp"
+#include "cellrt/workload.hpp"
 
 namespace {
 
 using namespace cellrt;
 using bench::median;
 
-struct FrameRays {
+// The rays every configuration traces.
+struct Rays {
     std::vector<Ray> primary, shadow;
 };
 
-FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
-    const PinholeCamera camera(scene.camera, width, height);
-    const PacketGrid grid(width, height, tile);
-    FrameRays f;
-    std::vector<std::uint32_t> order;
-    for (std::size_t p = 0; p < grid.count(); ++p) {
-        const PixelRect r = grid.rect(p);
-        order.resize(static_cast<std::size_t>(r.pixels()));
-        packet_order(r, order);
-        for (const std::uint32_t o : order)
-            f.primary.push_back(camera.primary(r.x0 + static_cast<int>(o) % r.width(), r.y0 + static_cast<int>(o) / r.width()));
-    }
-    const auto exact = make_accelerator(scene.triangles, AccelConfig{"kd"});
-    std::vector<Hit> hits(f.primary.size());
-    exact->intersect(f.primary, hits);
-    for (std::size_t i = 0; i < hits.size(); ++i)
-        if (hits[i].is_hit()) {
-            const SurfacePoint sp = surface_point(scene.triangles[hits[i].prim], f.primary[i], hits[i]);
-            f.shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
-        }
-    return f;
+// The frame workload in 16 x 16 packets, the hits found by `exact` (workload.hpp).
+Rays frame(const Scene& scene, const Accelerator& exact, int width, int height) {
+    FrameRays f = frame_rays(scene, width, height, 16, exact);
+    return {std::move(f.primary), std::move(f.shadow)};
 }
 
 // Incoherent rays, for the packet kernels' worst case: origins uniform in the scene's box,
 // directions uniform on the sphere; the same rays (with tfar a third of the box's diagonal) serve as
 // "shadow" rays. Deterministic (SplitMix64).
-FrameRays random_rays(const Scene& scene, std::size_t n) {
+Rays random_rays(const Scene& scene, std::size_t n) {
     const Box3 b = scene.bounds();
     std::uint64_t state = 0x9e3779b97f4a7c15ull;
     auto next = [&] {
@@ -70,7 +52,7 @@ FrameRays random_rays(const Scene& scene, std::size_t n) {
         z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
         return static_cast<float>((z ^ (z >> 31)) >> 40) / static_cast<float>(1 << 24);
     };
-    FrameRays f;
+    Rays f;
     while (f.primary.size() < n) {
         Ray r;
         for (int a = 0; a < 3; ++a) r.org[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * next();
@@ -145,10 +127,14 @@ int main(int argc, char** argv) {
             if (!spec) continue;
             const Scene scene = load_scene(*spec);
             auto [w, h] = size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", size);
-            const FrameRays rays = ray_kind == "frame" ? frame_rays(scene, w, h, 16)
-                                                       : random_rays(scene, static_cast<std::size_t>(w) * h);
-            std::vector<Hit> exact(rays.primary.size());
-            make_accelerator(scene.triangles, AccelConfig{"kd"})->intersect(rays.primary, exact);
+            std::vector<Hit> exact;
+            const Rays rays = [&] {  // the exact structure is gone before the configurations are built
+                const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
+                Rays r = ray_kind == "frame" ? frame(scene, *kd, w, h) : random_rays(scene, static_cast<std::size_t>(w) * h);
+                exact.resize(r.primary.size());
+                kd->intersect(r.primary, exact);
+                return r;
+            }();
 
             std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
                         scene.triangles.size(), w, h, rays.primary.size(), rays.shadow.size());
