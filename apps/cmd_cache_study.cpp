@@ -221,8 +221,8 @@ Runner add_cache_study(CLI::App& app) {
         checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
         if (o->sample < 1 || o->sample > 1024)
             throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
-        if (o->packet < 1 || o->packet > 256)
-            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, 256]");
+        if (o->packet < 1 || o->packet > kMaxPacket)
+            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
         std::error_code ec;
         std::filesystem::create_directories(o->out, ec);
         if (!std::filesystem::is_directory(o->out)) throw Error("--out '" + o->out + "': cannot create the folder");
