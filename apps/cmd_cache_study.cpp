@@ -6,10 +6,11 @@
 // moved, modelled cycles, wall time. bench/plot_cache_study.py draws the graphs from the CSV; the best
 // layouts are compared with the study's in best_layouts.md (docs/LOCALSTORE.md discusses them).
 //
-// Rays: those of one frame as the renderer traces them, packet by packet (primary rays, then the
-// shadow rays of their hits), of a sample of the packets: those whose column + row is a multiple of
-// --sample. Each run is one worker tracing the sample in order, so its figures are reproducible;
-// runs are spread over --threads threads.
+// Rays: those of one frame as the renderer traces them (workload.hpp), packet by packet: a packet's
+// primary rays in the renderer's packet order (Morton order), then the shadow rays of their hits, of
+// a sample of the packets: those whose column + row is a multiple of --sample. Each run is one worker
+// tracing the sample in order, so its figures are reproducible; runs are spread over --threads
+// threads.
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
@@ -20,11 +21,11 @@
 #include <unistd.h>
 
 #include "accel/local_store_registry.hpp"
-#include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
+#include "cellrt/workload.hpp"
 #include "cli.hpp"
 
 namespace cellrt::cli {
@@ -56,46 +57,13 @@ constexpr CacheLayout kStudyTriangleLayout{1024, 16, 1};
 // The triangle cache while the node cache is swept, as in the study.
 constexpr CacheLayout kFixedTriangleLayout{128, 128, 1};
 
-// The sampled packets of one frame: primary rays and the shadow rays of their hits, packet by packet.
-struct Workload {
-    struct Packet {
-        std::size_t primary, primary_count, shadow, shadow_count;
-    };
-    std::vector<Packet> packets;
-    std::vector<Ray> primary, shadow;
-    std::size_t frame_packets = 0;
-    std::uint64_t frame_rays = 0;  // primary and shadow rays of the whole frame
-};
-
-Workload sampled_frame(const Scene& scene, int width, int height, int packet, int sample) {
-    const PinholeCamera camera(scene.camera, width, height);
+// The frame's packets whose column + row is a multiple of `sample`, traced as the renderer traces
+// them (workload.hpp), with the hits of an exact kd-tree.
+FrameRays sampled_frame(const Scene& scene, int width, int height, int packet, int sample) {
     const PacketGrid grid(width, height, packet);
-    const auto exact = make_accelerator(scene.triangles, AccelConfig{"kd"});
-    Workload w;
-    w.frame_packets = grid.count();
-    std::vector<Ray> rays, shadow;
-    std::vector<Hit> hits;
-    for (std::size_t p = 0; p < grid.count(); ++p) {
-        const PixelRect r = grid.rect(p);
-        rays.clear();
-        shadow.clear();
-        for (int y = r.y0; y < r.y1; ++y)
-            for (int x = r.x0; x < r.x1; ++x) rays.push_back(camera.primary(x, y));
-        hits.resize(rays.size());
-        exact->intersect(rays, hits);
-        for (std::size_t i = 0; i < rays.size(); ++i)
-            if (hits[i].is_hit()) {
-                const SurfacePoint sp = surface_point(scene.triangles[hits[i].prim], rays[i], hits[i]);
-                shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
-            }
-        w.frame_rays += rays.size() + shadow.size();
-        const std::size_t column = p % static_cast<std::size_t>(grid.columns()), row = p / grid.columns();
-        if ((column + row) % static_cast<std::size_t>(sample) != 0) continue;
-        w.packets.push_back({w.primary.size(), rays.size(), w.shadow.size(), shadow.size()});
-        w.primary.insert(w.primary.end(), rays.begin(), rays.end());
-        w.shadow.insert(w.shadow.end(), shadow.begin(), shadow.end());
-    }
-    return w;
+    const auto columns = static_cast<std::size_t>(grid.columns());
+    return frame_rays(scene, width, height, packet, *make_accelerator(scene.triangles, AccelConfig{"kd"}),
+                      [&](std::size_t p) { return (p % columns + p / columns) % static_cast<std::size_t>(sample) == 0; });
 }
 
 struct Run {
@@ -108,12 +76,12 @@ struct Result {
     double wall_seconds = 0.0;
 };
 
-Result trace(const LocalStoreAccelerator& base, const Run& run, const Workload& w) {
+Result trace(const LocalStoreAccelerator& base, const Run& run, const FrameRays& w) {
     const auto accel = base.with_local_store(run.config, run.traversal);
     std::vector<Hit> hits;
     std::vector<std::uint8_t> occluded;
     Timer timer;
-    for (const Workload::Packet& p : w.packets) {
+    for (const FrameRays::Packet& p : w.packets) {
         hits.resize(p.primary_count);
         accel->intersect(std::span(w.primary).subspan(p.primary, p.primary_count), hits);
         occluded.resize(p.shadow_count);
@@ -124,7 +92,7 @@ Result trace(const LocalStoreAccelerator& base, const Run& run, const Workload& 
 
 // Runs every run on `threads` threads, each run on one thread; results in the order of `runs`.
 std::vector<Result> trace_all(const std::map<std::string, std::unique_ptr<LocalStoreAccelerator>>& bases,
-                              const std::vector<Run>& runs, const Workload& w, unsigned threads) {
+                              const std::vector<Run>& runs, const FrameRays& w, unsigned threads) {
     std::vector<Result> results(runs.size());
     std::atomic<std::size_t> next{0}, done{0};
     std::atomic<bool> failed{false};
@@ -256,8 +224,8 @@ Runner add_cache_study(CLI::App& app) {
         checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
         if (o->sample < 1 || o->sample > 1024)
             throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
-        if (o->packet < 1 || o->packet > 256)
-            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, 256]");
+        if (o->packet < 1 || o->packet > kMaxPacket)
+            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
         std::error_code ec;
         std::filesystem::create_directories(o->out, ec);
         if (!std::filesystem::is_directory(o->out)) throw Error("--out '" + o->out + "': cannot create the folder");
@@ -276,12 +244,12 @@ Runner add_cache_study(CLI::App& app) {
             const Scene scene = load_scene(spec);
             int width = scene.width, height = scene.height;
             if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
-            const Workload w = sampled_frame(scene, width, height, o->packet, o->sample);
+            const FrameRays w = sampled_frame(scene, width, height, o->packet, o->sample);
             std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): %zu "
                         "primary + %zu shadow rays of the frame's %llu\n",
-                        scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(), w.frame_packets,
-                        o->packet, o->packet, o->sample, w.primary.size(), w.shadow.size(),
-                        static_cast<unsigned long long>(w.frame_rays));
+                        scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
+                        PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample, w.primary.size(),
+                        w.shadow.size(), static_cast<unsigned long long>(w.frame_ray_count));
             std::fflush(stdout);
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
             std::vector<Run> runs;
@@ -309,7 +277,7 @@ Runner add_cache_study(CLI::App& app) {
             std::map<std::string, std::vector<std::size_t>> groups;  // runs of one sweep, in order
             std::vector<std::string> group_order;
             for (std::size_t i = 0; i < runs.size(); ++i) {
-                csv += csv_row(scene.name, runs[i], results[i], w.frame_rays);
+                csv += csv_row(scene.name, runs[i], results[i], w.frame_ray_count);
                 const std::string key = runs[i].structure + runs[i].sweep + runs[i].traversal +
                                         to_string(runs[i].config.access);
                 if (groups[key].empty()) group_order.push_back(key);

@@ -4,8 +4,10 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 #include "accel/local_store_registry.hpp"
+#include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
@@ -42,7 +44,8 @@ struct LocalStoreOptions {
         };
     }
 
-    // The model's configuration for packets of `packet` x `packet` rays; throws naming the option at fault.
+    // The model's configuration for packets of `packet` x `packet` rays (a valid packet edge); throws
+    // naming the option at fault.
     LocalStoreConfig config(int packet) const {
         if (!enabled) {
             for (const CLI::Option* opt : dependent)
@@ -58,11 +61,38 @@ struct LocalStoreOptions {
         if (kib < 16 || kib > 16384)
             throw Error("--local-store-kib " + std::to_string(kib) + " must lie in [16, 16384]");
         c.budget_bytes = static_cast<std::size_t>(kib) * 1024;
-        if (packet < 1 || packet > 256) throw Error("--packet " + std::to_string(packet) + " must lie in [1, 256]");
         c.packet_rays = static_cast<std::size_t>(packet) * packet;
         return c;
     }
 };
+
+// The library's error for what the user gave as `option`, under the option's name: the library speaks
+// of what the value means, the user typed the option.
+Error option_error(const std::string& option, const Error& e) { return Error(option + ": " + e.what()); }
+
+// The structure for `config`. Where it is refused and the library refuses the SIMD set too, the error
+// is the --simd option's (looked at only after a refusal: Embree ignores the set, and a bad one is no
+// error for it).
+std::unique_ptr<Accelerator> make_structure(const Scene& scene, const AccelConfig& config) {
+    try {
+        return make_accelerator(scene.triangles, config);
+    } catch (const Error&) {
+        if (config.simd == "off") throw;
+        try {
+            detail::parse_isa(config.simd);
+        } catch (const Error& e) {
+            throw option_error("--simd", e);
+        }
+        throw;
+    }
+}
+
+// Refuses at the start, before any work, to replace a file the user has.
+void check_output(const std::string& path, bool overwrite) {
+    std::error_code ec;
+    if (!overwrite && std::filesystem::exists(path, ec))
+        throw Error(path + ": file exists (pass --overwrite to replace it)");
+}
 
 double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 
@@ -156,7 +186,11 @@ Runner add_render(CLI::App& app) {
     o->local_store.add_to(*cmd);
     cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE");
     return [o] {
+        if (o->packet < 1 || o->packet > kMaxPacket)
+            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
         const LocalStoreConfig local_store = o->local_store.config(o->packet);
+        check_output(o->out, o->overwrite);
+        if (!o->stats.empty()) check_output(o->stats, o->overwrite);
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         const double load_s = load_timer.seconds();
@@ -166,7 +200,11 @@ Runner add_render(CLI::App& app) {
         if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o->size);
         ro.threads = o->accel.threads;
         ro.packet = o->packet;
-        ro.dispatch = parse_dispatch(o->dispatch);
+        try {
+            ro.dispatch = parse_dispatch(o->dispatch);
+        } catch (const Error& e) {
+            throw option_error("--dispatch", e);
+        }
         ro.pin = o->pin;
         ro.cancel = &g_cancel;
         std::unique_ptr<LocalStoreAccelerator> modelled;
@@ -176,8 +214,7 @@ Runner add_render(CLI::App& app) {
             if (o->accel.simd_option->count() == 0) config.simd = "off";
             modelled = make_local_store_accelerator(scene.triangles, config, local_store);
         }
-        const std::unique_ptr<Accelerator> direct =
-            modelled ? nullptr : make_accelerator(scene.triangles, o->accel.config());
+        const std::unique_ptr<Accelerator> direct = modelled ? nullptr : make_structure(scene, o->accel.config());
         const Accelerator& accel = modelled ? *modelled : *direct;
         Progress progress;
         ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };

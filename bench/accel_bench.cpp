@@ -13,55 +13,38 @@
 #include <ctime>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
-#include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
-#include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
-#include "cellrt/schedule.hpp"
 #include "cellrt/timer.hpp"
+#include "cellrt/workload.hpp"
 
 namespace {
 
 using namespace cellrt;
 using bench::median;
 
-struct FrameRays {
+// The rays every configuration traces.
+struct Rays {
     std::vector<Ray> primary, shadow;
 };
 
-FrameRays frame_rays(const Scene& scene, int width, int height, int tile) {
-    const PinholeCamera camera(scene.camera, width, height);
-    const PacketGrid grid(width, height, tile);
-    FrameRays f;
-    std::vector<std::uint32_t> order;
-    for (std::size_t p = 0; p < grid.count(); ++p) {
-        const PixelRect r = grid.rect(p);
-        order.resize(static_cast<std::size_t>(r.pixels()));
-        packet_order(r, order);
-        for (const std::uint32_t o : order)
-            f.primary.push_back(camera.primary(r.x0 + static_cast<int>(o) % r.width(), r.y0 + static_cast<int>(o) / r.width()));
-    }
-    const auto exact = make_accelerator(scene.triangles, AccelConfig{"kd"});
-    std::vector<Hit> hits(f.primary.size());
-    exact->intersect(f.primary, hits);
-    for (std::size_t i = 0; i < hits.size(); ++i)
-        if (hits[i].is_hit()) {
-            const SurfacePoint sp = surface_point(scene.triangles[hits[i].prim], f.primary[i], hits[i]);
-            f.shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
-        }
-    return f;
+// The frame workload in 16 x 16 packets, the hits found by `exact` (workload.hpp).
+Rays frame(const Scene& scene, const Accelerator& exact, int width, int height) {
+    FrameRays f = frame_rays(scene, width, height, 16, exact);
+    return {std::move(f.primary), std::move(f.shadow)};
 }
 
 // Incoherent rays, for the packet kernels' worst case: origins uniform in the scene's box,
 // directions uniform on the sphere; the same rays (with tfar a third of the box's diagonal) serve as
 // "shadow" rays. Deterministic (SplitMix64).
-FrameRays random_rays(const Scene& scene, std::size_t n) {
+Rays random_rays(const Scene& scene, std::size_t n) {
     const Box3 b = scene.bounds();
     std::uint64_t state = 0x9e3779b97f4a7c15ull;
     auto next = [&] {
@@ -70,7 +53,7 @@ FrameRays random_rays(const Scene& scene, std::size_t n) {
         z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
         return static_cast<float>((z ^ (z >> 31)) >> 40) / static_cast<float>(1 << 24);
     };
-    FrameRays f;
+    Rays f;
     while (f.primary.size() < n) {
         Ray r;
         for (int a = 0; a < 3; ++a) r.org[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * next();
@@ -84,6 +67,59 @@ FrameRays random_rays(const Scene& scene, std::size_t n) {
     return f;
 }
 
+struct Options {
+    std::string scenes_dir = "../shared/scenes";
+    std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
+    std::vector<std::string> configs{"embree:single", "embree:packet16", "kd:rec", "kd:branched", "kd:branchless",
+                                     "kd+auto", "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"};
+    int repeats = 5, builds = 3, batch = 256;
+    unsigned threads = 1;
+    std::string size, json_path, clock = "wall", ray_kind = "frame";
+};
+
+// Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
+// option), as CLI11_PARSE would.
+std::optional<int> parse_options(int argc, char** argv, Options& o) {
+    CLI::App app{"cellrt structures vs Embree: build time, memory, Mrays/s on the same rays in the same run"};
+    app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
+    app.add_option("--scenes", o.scenes, "Shared scene names or builtin:... specs")->capture_default_str();
+    app.add_option("--configs", o.configs, "KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...]; embree ones are the yardsticks")->capture_default_str();
+    app.add_option("--repeats", o.repeats, "Timed passes per ray kind (median)")->capture_default_str()->check(CLI::Range(1, 1000));
+    app.add_option("--builds", o.builds, "Timed builds (median)")->capture_default_str()->check(CLI::Range(1, 100));
+    app.add_option("--batch", o.batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));
+    app.add_option("--threads", o.threads, "Build threads (tracing is single-threaded)")->capture_default_str();
+    app.add_option("--size", o.size, "Image size WxH (default: the view file's)");
+    app.add_option("--json", o.json_path, "Write every result as JSON");
+    app.add_option("--rays", o.ray_kind, "frame: a frame's primary and shadow rays; random: incoherent rays")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"frame", "random"}));
+    app.add_option("--clock", o.clock, "Time tracing by the wall clock or this thread's CPU clock")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"wall", "cpu"}));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    return std::nullopt;
+}
+
+// A scene's rays of `kind` and the exact closest hits of its primary rays, from a kd-tree that is gone
+// before the configurations are built.
+struct SceneRays {
+    Rays rays;
+    std::vector<Hit> exact;
+};
+
+SceneRays scene_rays(const Scene& scene, const std::string& kind, int width, int height) {
+    const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    SceneRays s;
+    s.rays = kind == "frame" ? frame(scene, *kd, width, height) : random_rays(scene, static_cast<std::size_t>(width) * height);
+    s.exact.resize(s.rays.primary.size());
+    kd->intersect(s.rays.primary, s.exact);
+    return s;
+}
+
 struct Result {
     std::string config;
     bool embree = false;
@@ -91,6 +127,42 @@ struct Result {
     std::size_t differing = 0;  // primary hits that differ from the exact answer
     TraversalCounters primary_work, shadow_work;
 };
+
+// A configuration: its structure, its figures so far and its timed passes.
+struct Entry {
+    Result r;
+    std::unique_ptr<Accelerator> accel;
+    std::vector<double> primary_s, shadow_s;
+};
+
+// Every configuration built --builds times (median build time); one that this binary or processor
+// cannot build is skipped with a message.
+std::vector<Entry> build_configurations(const Scene& scene, const Options& o) {
+    std::vector<Entry> entries;
+    for (const std::string& text : o.configs) {
+        AccelConfig cfg = parse_accel_config(text);
+        cfg.threads = o.threads;
+        if (!bench::built_in(cfg.kind)) continue;
+        Entry e;
+        e.r.config = text;
+        e.r.embree = cfg.kind == "embree";
+        std::vector<double> build_times;
+        try {
+            for (int b = 0; b < o.builds; ++b) {
+                e.accel.reset();
+                e.accel = make_accelerator(scene.triangles, cfg);
+                build_times.push_back(e.accel->stats().build_seconds);
+            }
+        } catch (const Error& err) {  // e.g. a packet width this processor lacks
+            std::fprintf(stderr, "skipping %s: %s\n", text.c_str(), err.what());
+            continue;
+        }
+        e.r.build_s = median(build_times);
+        e.r.memory_mib = static_cast<double>(e.accel->stats().memory_bytes) / (1024.0 * 1024.0);
+        entries.push_back(std::move(e));
+    }
+    return entries;
+}
 
 double per_ray(std::uint64_t n, const TraversalCounters& c) { return c.rays ? double(n) / double(c.rays) : 0.0; }
 
@@ -110,165 +182,133 @@ double timed_pass(std::size_t n, std::size_t batch, bool cpu_clock, Call&& call)
     return now(cpu_clock) - start;
 }
 
+// After a warm-up pass each, the timed passes go round the configurations (primary and shadow rays
+// of each in turn, --repeats rounds), so that a slow spell of a shared machine falls on all of them
+// alike and the ratios hold.
+void timed_passes(std::vector<Entry>& entries, const Rays& rays, const Options& o) {
+    std::vector<Hit> hits(rays.primary.size());
+    std::vector<std::uint8_t> occluded(rays.shadow.size());
+    const std::size_t bs = static_cast<std::size_t>(o.batch);
+    const bool cpu = o.clock == "cpu";
+    auto passes = [&](Entry& e) {
+        const double tp = timed_pass(rays.primary.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
+            e.accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
+        });
+        const double ts = timed_pass(rays.shadow.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
+            e.accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
+        });
+        return std::pair{tp, ts};
+    };
+    for (Entry& e : entries) passes(e);  // warm-up
+    for (int k = 0; k < o.repeats; ++k)
+        for (Entry& e : entries) {
+            const auto [tp, ts] = passes(e);
+            e.primary_s.push_back(tp);
+            e.shadow_s.push_back(ts);
+        }
+}
+
+// Each configuration's median times, its work per ray and how many of its primary hits differ from
+// the exact ones; the structures are freed on the way.
+std::vector<Result> results_of(std::vector<Entry>& entries, const Rays& rays, const std::vector<Hit>& exact) {
+    std::vector<Hit> hits(rays.primary.size());
+    std::vector<std::uint8_t> occluded(rays.shadow.size());
+    std::vector<Result> results;
+    for (Entry& e : entries) {
+        Result& r = e.r;
+        r.primary_s = median(e.primary_s);
+        r.shadow_s = median(e.shadow_s);
+        e.accel->intersect(rays.primary, hits, &r.primary_work);
+        e.accel->occluded(rays.shadow, occluded, &r.shadow_work);
+        for (std::size_t i = 0; i < hits.size(); ++i) r.differing += !(hits[i].prim == exact[i].prim);
+        results.push_back(r);
+        e.accel.reset();
+    }
+    return results;
+}
+
+// The scene's table, with ratios to Embree in this run: builds to its first configuration (its
+// default build), rays per second to rtcIntersect1 (`embree:single`) and to its fastest configuration.
+void print_table(const std::vector<Result>& results, const Rays& rays) {
+    const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.shadow.size());
+    auto total = [&](const Result& r) { return (np + ns) / (r.primary_s + r.shadow_s) * 1e-6; };
+    const Result *first = nullptr, *single = nullptr, *best = nullptr;
+    for (const Result& r : results) {
+        if (!r.embree) continue;
+        if (!first) first = &r;
+        if (r.config == "embree:single" || r.config == "embree") single = &r;
+        if (!best || total(r) > total(*best)) best = &r;
+    }
+    std::printf("| config | build ms | build ÷ Embree | memory MiB | primary Mrays/s | shadow Mrays/s | "
+                "total Mrays/s | × Embree 1 | × Embree best | hits ≠ exact | nodes/leaves/tris per primary "
+                "ray | per shadow ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    auto ratio = [](const Result* y, double value, double of_y) {
+        if (!y) return std::string("–");
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.2f", value / of_y);
+        return std::string(buf);
+    };
+    for (const Result& r : results) {
+        const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
+        std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | %.1f / "
+                    "%.1f / %.1f |\n",
+                    r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
+                    r.memory_mib, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
+                    ratio(single, total(r), single ? total(*single) : 1).c_str(),
+                    ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing, per_ray(pw.nodes, pw),
+                    per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
+                    per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
+    }
+}
+
+nlohmann::json json_row(const Scene& scene, int width, int height, const Rays& rays, const Result& r) {
+    const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
+    return {{"scene", scene.name},
+            {"config", r.config},
+            {"width", width},
+            {"height", height},
+            {"triangles", scene.triangles.size()},
+            {"primary_rays", rays.primary.size()},
+            {"shadow_rays", rays.shadow.size()},
+            {"build_seconds", r.build_s},
+            {"memory_mib", r.memory_mib},
+            {"primary_seconds", r.primary_s},
+            {"shadow_seconds", r.shadow_s},
+            {"differing_primary_hits", r.differing},
+            {"primary_per_ray", {{"nodes", per_ray(pw.nodes, pw)}, {"leaves", per_ray(pw.leaves, pw)},
+                                 {"triangles", per_ray(pw.triangles, pw)}}},
+            {"shadow_per_ray", {{"nodes", per_ray(sw.nodes, sw)}, {"leaves", per_ray(sw.leaves, sw)},
+                                {"triangles", per_ray(sw.triangles, sw)}}}};
+}
+
+// One scene: its rays, every configuration built and timed, its table; its JSON rows go to `out`.
+void bench_scene(const Scene& scene, const Options& o, nlohmann::json& out) {
+    const auto [w, h] = o.size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", o.size);
+    const SceneRays s = scene_rays(scene, o.ray_kind, w, h);
+    std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
+                scene.triangles.size(), w, h, s.rays.primary.size(), s.rays.shadow.size());
+    std::vector<Entry> entries = build_configurations(scene, o);
+    timed_passes(entries, s.rays, o);
+    const std::vector<Result> results = results_of(entries, s.rays, s.exact);
+    std::fprintf(stderr, "%s done\n", scene.name.c_str());
+    print_table(results, s.rays);
+    for (const Result& r : results) out.push_back(json_row(scene, w, h, s.rays, r));
+    std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"cellrt structures vs Embree: build time, memory, Mrays/s on the same rays in the same run"};
-    std::string scenes_dir = "../shared/scenes";
-    std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
-    std::vector<std::string> configs{"embree:single", "embree:packet16", "kd:rec", "kd:branched", "kd:branchless",
-                                     "kd+auto", "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"};
-    int repeats = 5, builds = 3, batch = 256;
-    unsigned threads = 1;
-    std::string size, json_path, clock = "wall", ray_kind = "frame";
-    app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
-    app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
-    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...]; embree ones are the yardsticks")->capture_default_str();
-    app.add_option("--repeats", repeats, "Timed passes per ray kind (median)")->capture_default_str()->check(CLI::Range(1, 1000));
-    app.add_option("--builds", builds, "Timed builds (median)")->capture_default_str()->check(CLI::Range(1, 100));
-    app.add_option("--batch", batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));
-    app.add_option("--threads", threads, "Build threads (tracing is single-threaded)")->capture_default_str();
-    app.add_option("--size", size, "Image size WxH (default: the view file's)");
-    app.add_option("--json", json_path, "Write every result as JSON");
-    app.add_option("--rays", ray_kind, "frame: a frame's primary and shadow rays; random: incoherent rays")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"frame", "random"}));
-    app.add_option("--clock", clock, "Time tracing by the wall clock or this thread's CPU clock")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"wall", "cpu"}));
-    CLI11_PARSE(app, argc, argv);
-
+    Options o;
+    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
     nlohmann::json out = nlohmann::json::array();
     try {
-        for (const std::string& name : scenes) {
-            const auto spec = bench::scene_spec(scenes_dir, name);
-            if (!spec) continue;
-            const Scene scene = load_scene(*spec);
-            auto [w, h] = size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", size);
-            const FrameRays rays = ray_kind == "frame" ? frame_rays(scene, w, h, 16)
-                                                       : random_rays(scene, static_cast<std::size_t>(w) * h);
-            std::vector<Hit> exact(rays.primary.size());
-            make_accelerator(scene.triangles, AccelConfig{"kd"})->intersect(rays.primary, exact);
-
-            std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
-                        scene.triangles.size(), w, h, rays.primary.size(), rays.shadow.size());
-            // Every configuration is built first; then the timed passes go round the configurations
-            // (primary and shadow rays of each in turn, `repeats` rounds), so that a slow spell of a
-            // shared machine falls on all of them alike and the ratios hold.
-            struct Entry {
-                Result r;
-                std::unique_ptr<Accelerator> accel;
-                std::vector<double> primary_s, shadow_s;
-            };
-            std::vector<Entry> entries;
-            for (const std::string& text : configs) {
-                AccelConfig cfg = parse_accel_config(text);
-                cfg.threads = threads;
-                if (!bench::built_in(cfg.kind)) continue;
-                Entry e;
-                e.r.config = text;
-                e.r.embree = cfg.kind == "embree";
-                std::vector<double> build_times;
-                try {
-                    for (int b = 0; b < builds; ++b) {
-                        e.accel.reset();
-                        e.accel = make_accelerator(scene.triangles, cfg);
-                        build_times.push_back(e.accel->stats().build_seconds);
-                    }
-                } catch (const Error& err) {  // e.g. a packet width this processor lacks
-                    std::fprintf(stderr, "skipping %s: %s\n", text.c_str(), err.what());
-                    continue;
-                }
-                e.r.build_s = median(build_times);
-                e.r.memory_mib = static_cast<double>(e.accel->stats().memory_bytes) / (1024.0 * 1024.0);
-                entries.push_back(std::move(e));
-            }
-            std::vector<Hit> hits(rays.primary.size());
-            std::vector<std::uint8_t> occluded(rays.shadow.size());
-            const std::size_t bs = static_cast<std::size_t>(batch);
-            const bool cpu = clock == "cpu";
-            auto passes = [&](Entry& e) {
-                const double tp = timed_pass(rays.primary.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
-                    e.accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
-                });
-                const double ts = timed_pass(rays.shadow.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
-                    e.accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
-                });
-                return std::pair{tp, ts};
-            };
-            for (Entry& e : entries) passes(e);  // warm-up
-            for (int k = 0; k < repeats; ++k)
-                for (Entry& e : entries) {
-                    const auto [tp, ts] = passes(e);
-                    e.primary_s.push_back(tp);
-                    e.shadow_s.push_back(ts);
-                }
-            std::vector<Result> results;
-            for (Entry& e : entries) {
-                Result& r = e.r;
-                r.primary_s = median(e.primary_s);
-                r.shadow_s = median(e.shadow_s);
-                e.accel->intersect(rays.primary, hits, &r.primary_work);
-                e.accel->occluded(rays.shadow, occluded, &r.shadow_work);
-                for (std::size_t i = 0; i < hits.size(); ++i) r.differing += !(hits[i].prim == exact[i].prim);
-                results.push_back(r);
-                e.accel.reset();
-            }
-            std::fprintf(stderr, "%s done\n", scene.name.c_str());
-
-            // Ratios to Embree in this run: builds to its first configuration (its default build),
-            // rays per second to rtcIntersect1 (`embree:single`) and to its fastest configuration.
-            const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.shadow.size());
-            auto total = [&](const Result& r) { return (np + ns) / (r.primary_s + r.shadow_s) * 1e-6; };
-            const Result *first = nullptr, *single = nullptr, *best = nullptr;
-            for (const Result& r : results) {
-                if (!r.embree) continue;
-                if (!first) first = &r;
-                if (r.config == "embree:single" || r.config == "embree") single = &r;
-                if (!best || total(r) > total(*best)) best = &r;
-            }
-            std::printf("| config | build ms | build ÷ Embree | memory MiB | primary Mrays/s | shadow Mrays/s | "
-                        "total Mrays/s | × Embree 1 | × Embree best | hits ≠ exact | nodes/leaves/tris per primary "
-                        "ray | per shadow ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-            auto ratio = [](const Result* y, double value, double of_y) {
-                if (!y) return std::string("–");
-                char buf[32];
-                std::snprintf(buf, sizeof buf, "%.2f", value / of_y);
-                return std::string(buf);
-            };
-            for (const Result& r : results) {
-                const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
-                std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | %.1f / "
-                            "%.1f / %.1f |\n",
-                            r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
-                            r.memory_mib, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
-                            ratio(single, total(r), single ? total(*single) : 1).c_str(),
-                            ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing, per_ray(pw.nodes, pw),
-                            per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
-                            per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
-                out.push_back({{"scene", scene.name},
-                               {"config", r.config},
-                               {"width", w},
-                               {"height", h},
-                               {"triangles", scene.triangles.size()},
-                               {"primary_rays", rays.primary.size()},
-                               {"shadow_rays", rays.shadow.size()},
-                               {"build_seconds", r.build_s},
-                               {"memory_mib", r.memory_mib},
-                               {"primary_seconds", r.primary_s},
-                               {"shadow_seconds", r.shadow_s},
-                               {"differing_primary_hits", r.differing},
-                               {"primary_per_ray", {{"nodes", per_ray(pw.nodes, pw)}, {"leaves", per_ray(pw.leaves, pw)},
-                                                    {"triangles", per_ray(pw.triangles, pw)}}},
-                               {"shadow_per_ray", {{"nodes", per_ray(sw.nodes, sw)}, {"leaves", per_ray(sw.leaves, sw)},
-                                                   {"triangles", per_ray(sw.triangles, sw)}}}});
-            }
-            std::fflush(stdout);
-        }
+        for (const std::string& name : o.scenes)
+            if (const auto spec = bench::scene_spec(o.scenes_dir, name)) bench_scene(load_scene(*spec), o, out);
     } catch (const Error& e) {
         std::fprintf(stderr, "cellrt_bench: error: %s\n", e.what());
         return 1;
     }
-    if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
+    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
     return 0;
 }

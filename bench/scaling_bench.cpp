@@ -73,8 +73,18 @@ int main(int argc, char** argv) {
     app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
     app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
         ->capture_default_str();
-    app.add_option("--dispatch", dispatches, "Dispatch modes")->capture_default_str();
-    app.add_option("--packets", packets, "Packet edges P (P x P rays)")->capture_default_str();
+    // Checked here, so that CLI11 names the option in front of the library's message.
+    app.add_option("--dispatch", dispatches, "Dispatch modes")->capture_default_str()->check([](const std::string& d) {
+        try {
+            parse_dispatch(d);
+            return std::string();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+    });
+    app.add_option("--packets", packets, "Packet edges P (P x P rays)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxPacket));
     app.add_option("--workers", workers, "Worker counts (default 1..cores)");
     app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str()->check(CLI::Range(1, 100));
     app.add_option("--size", size, "Image size WxH (the study's: 512x512)")->capture_default_str();

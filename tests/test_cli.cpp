@@ -12,6 +12,8 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 #include "cellrt/image.hpp"
@@ -30,7 +32,8 @@ struct TempDir {
     ~TempDir() { fs::remove_all(path); }
 };
 
-pid_t spawn(const std::vector<std::string>& args) {
+// Runs the program with its output thrown away, or its error output written to `error_file`.
+pid_t spawn(const std::vector<std::string>& args, const std::string& error_file = "/dev/null") {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -38,7 +41,7 @@ pid_t spawn(const std::vector<std::string>& args) {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, error_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     const int rc = posix_spawn(&pid, CELLRT_CLI, &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     return rc == 0 ? pid : -1;
@@ -118,6 +121,29 @@ TEST(Cli, RefusesBadOptions) {
              {"render", "-o", (dir.path / "no" / "such" / "x.png").string()},
          }) {
         EXPECT_NE(run(args), 0) << args[1] << " " << args[2];
+        EXPECT_FALSE(fs::exists(out));
+    }
+}
+
+// The library's messages speak of what a value means; the program puts the option in front.
+TEST(Cli, NamesTheOptionAtFault) {
+    TempDir dir;
+    const std::string out = (dir.path / "x.png").string(), existing = (dir.path / "existing.png").string();
+    std::ofstream(existing) << "mine";
+    const std::string errors = (dir.path / "errors.txt").string();
+    for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+             {{"render", "--packet", "0", "-o", out}, "--packet 0 must lie in [1, 256]"},
+             {{"render", "--dispatch", "push", "-o", out}, "--dispatch: dispatch mode 'push' is not one of: pull, mailbox"},
+             {{"render", "--simd", "avx9", "-o", out},
+              "--simd: SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
+             {{"render", "-o", existing}, existing + ": file exists (pass --overwrite to replace it)"},
+         }) {
+        std::vector<std::string> all{CELLRT_CLI};
+        all.insert(all.end(), args.begin(), args.end());
+        EXPECT_NE(wait_exit(spawn(all, errors)), 0) << args[1];
+        std::ifstream in(errors);
+        const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        EXPECT_EQ(text, "cellrt: error: " + message + "\n");
         EXPECT_FALSE(fs::exists(out));
     }
 }

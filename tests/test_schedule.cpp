@@ -178,9 +178,19 @@ TEST(Schedule, CancellationStopsEarlyAndReportsIt) {
     }
 }
 
+// In the library's words: the program puts its option's name in front.
 TEST(Schedule, RejectsBadSettings) {
-    EXPECT_THROW(PacketGrid(16, 16, 0), Error);
-    EXPECT_THROW(parse_dispatch("push"), Error);
+    auto error_of = [](auto&& f) {
+        try {
+            f();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(error_of([] { PacketGrid(16, 16, 0); }), "packet edge 0 must lie in [1, 256]");
+    EXPECT_EQ(error_of([] { PacketGrid(16, 16, kMaxPacket + 1); }), "packet edge 257 must lie in [1, 256]");
+    EXPECT_EQ(error_of([] { parse_dispatch("push"); }), "dispatch mode 'push' is not one of: pull, mailbox");
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
     std::vector<std::uint32_t> order(15);
     EXPECT_THROW(packet_order(PixelRect{0, 0, 4, 4}, order), Error);

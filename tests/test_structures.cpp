@@ -5,6 +5,7 @@
 
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "ray_suite.hpp"
 #include "simd/isa.hpp"
@@ -131,6 +132,29 @@ TEST(BruteForcePackets, SameAnswersAsTheScalarLoop) {
             c.simd = detail::to_string(isa);
             test::expect_matches(*make_accelerator(tris, c), ref, "brute+" + c.simd + " on " + name);
         }
+    }
+}
+
+// A SIMD set that does not exist, or that this build or processor cannot run, is refused in the
+// library's words (the program puts its --simd in front).
+TEST(SimdSets, RefusedInTheLibrarysWords) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    auto error_of = [&](const std::string& simd) {
+        try {
+            make_accelerator(scene.triangles, AccelConfig{.kind = "kd", .simd = simd});
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(error_of("avx9"), "SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512");
+    if (detail::available_isas().back() != detail::Isa::avx512) {
+        const std::string unavailable = error_of("avx512");
+        EXPECT_EQ(unavailable.rfind("SIMD instruction set avx512 is not available on this machine or in this build "
+                                    "(available: auto, off, portable",
+                                    0),
+                  0u)
+            << unavailable;
     }
 }
 

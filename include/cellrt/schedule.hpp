@@ -37,8 +37,12 @@ struct PixelRect {
     int pixels() const { return width() * height(); }
 };
 
-// The image in packets of `packet` x `packet` pixels, row-major; packets at the right and bottom
-// edges are cut to the image (partial packets are traced, never dropped).
+// The largest packet edge PacketGrid accepts.
+inline constexpr int kMaxPacket = 256;
+
+// The image in packets of `packet` x `packet` pixels (1 <= packet <= kMaxPacket), row-major; packets
+// at the right and bottom edges are cut to the image (partial packets are traced, never dropped).
+// Throws cellrt::Error for a size or a packet edge out of range.
 struct PacketGrid {
     int width, height, packet;
 

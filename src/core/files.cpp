@@ -19,7 +19,7 @@ std::string lower_extension(const std::string& path) {
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite) {
     namespace fs = std::filesystem;
     std::error_code ec;
-    if (!overwrite && fs::exists(path, ec)) throw Error(path + ": file exists (pass --overwrite to replace it)");
+    if (!overwrite && fs::exists(path, ec)) throw Error(path + ": file exists and overwrite is off");
     const fs::path target(path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");

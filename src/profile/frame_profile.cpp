@@ -55,9 +55,9 @@ AccelConfig config_for_callgrind(AccelConfig config, std::string& note) {
         return config;
     }
     if (config.simd != "auto")
-        throw Error("--simd avx512: valgrind cannot run AVX-512 code; profile it with hardware counters, or choose "
-                    "--simd avx2");
-    note = "valgrind cannot run AVX-512 code: profiling the avx2 packets (--simd avx2) instead";
+        throw Error("SIMD instruction set avx512: valgrind cannot run AVX-512 code; profile it with hardware "
+                    "counters, or choose avx2");
+    note = "valgrind cannot run AVX-512 code: profiling the avx2 packets instead";
     config.simd = detail::to_string(detail::Isa::avx2);
     return config;
 }

@@ -6,6 +6,7 @@
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
+#include "cellrt/workload.hpp"
 #include "schedule/cache_line.hpp"
 
 namespace cellrt {
@@ -19,67 +20,27 @@ Vec3 sky(const Vec3& dir) {
     return Vec3{0.9f, 0.95f, 1.f} * (1.f - k) + Vec3{0.35f, 0.55f, 0.9f} * k;
 }
 
-// Buffers of one worker, allocated once per render, reused for every packet. On cache lines of their
-// own: workers update their vectors' ends and counters and write the buffers on every packet.
+// One worker's packet rays and counters, made once per render and reused for every packet. On cache
+// lines of their own: workers update their counters on every packet.
 struct alignas(kCacheLine) PacketWork {
-    CacheLineVector<Ray> rays, shadow_rays;
-    CacheLineVector<Hit> hits;
-    CacheLineVector<std::uint8_t> occluded;
-    CacheLineVector<Vec3> normals;
-    CacheLineVector<std::uint32_t> shadow_pixel;
-    CacheLineVector<std::uint32_t> order;  // order[i]: the pixel (offset in the packet) of ray i
-    int order_width = 0, order_height = 0;  // the packet shape `order` was made for
+    PacketWorkload rays;
     TraversalCounters primary, shadow;
     std::uint64_t shadow_ray_count = 0;
-
-    void reserve(std::size_t n) {
-        rays.reserve(n);
-        shadow_rays.reserve(n);
-        hits.reserve(n);
-        occluded.reserve(n);
-        normals.reserve(n);
-        shadow_pixel.reserve(n);
-        order.reserve(n);
-    }
 };
 
-// Primary rays of the packet, one batch; then one shadow ray per hit, one batch; then shading.
-void trace_packet(const Scene& scene, const Accelerator& accel, const PinholeCamera& camera, const PixelRect& rect,
-                  bool count, PacketWork& w, std::span<Vec3> colours) {
-    if (rect.width() != w.order_width || rect.height() != w.order_height) {  // only edge packets differ
-        w.order.resize(static_cast<std::size_t>(rect.pixels()));
-        packet_order(rect, w.order);
-        w.order_width = rect.width();
-        w.order_height = rect.height();
-    }
-    w.rays.clear();
-    for (const std::uint32_t p : w.order)
-        w.rays.push_back(camera.primary(rect.x0 + static_cast<int>(p) % rect.width(), rect.y0 + static_cast<int>(p) / rect.width()));
-    w.hits.resize(w.rays.size());
-    accel.intersect(w.rays, w.hits, count ? &w.primary : nullptr);
-
-    w.shadow_rays.clear();
-    w.shadow_pixel.clear();
-    w.normals.resize(w.rays.size());
-    for (std::size_t i = 0; i < w.rays.size(); ++i) {
-        const Hit& h = w.hits[i];
-        if (!h.is_hit()) {
-            colours[w.order[i]] = sky(w.rays[i].dir);
-            continue;
-        }
-        const SurfacePoint sp = surface_point(scene.triangles[h.prim], w.rays[i], h);
-        w.normals[i] = sp.normal;
-        w.shadow_rays.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
-        w.shadow_pixel.push_back(static_cast<std::uint32_t>(i));
-    }
-    w.shadow_ray_count += w.shadow_rays.size();
-    w.occluded.resize(w.shadow_rays.size());
-    accel.occluded(w.shadow_rays, w.occluded, count ? &w.shadow : nullptr);
-
-    for (std::size_t k = 0; k < w.shadow_rays.size(); ++k) {
-        const std::uint32_t i = w.shadow_pixel[k];
-        const float lambert = w.occluded[k] ? 0.f : std::max(0.f, dot(w.normals[i], w.shadow_rays[k].dir));
-        colours[w.order[i]] = kAlbedo * (kAmbient + lambert) * scene.light.color;
+// The packet's rays (workload.hpp), then its shading: sky for a miss, diffuse light where the shadow
+// ray reaches the light, ambient light everywhere on a surface.
+void trace_packet(const Scene& scene, const Accelerator& accel, const PixelRect& rect, bool count, PacketWork& w,
+                  std::span<Vec3> colours) {
+    PacketWorkload& r = w.rays;
+    r.trace(rect, accel, count ? &w.primary : nullptr, count ? &w.shadow : nullptr);
+    w.shadow_ray_count += r.shadow().size();
+    const auto order = r.order();
+    for (std::size_t i = 0; i < r.primary().size(); ++i)
+        if (!r.hits()[i].is_hit()) colours[order[i]] = sky(r.primary()[i].dir);
+    for (std::size_t k = 0; k < r.shadow().size(); ++k) {
+        const float lambert = r.occluded()[k] ? 0.f : std::max(0.f, dot(r.normals()[k], r.shadow()[k].dir));
+        colours[order[r.shadow_primary()[k]]] = kAlbedo * (kAmbient + lambert) * scene.light.color;
     }
 }
 
@@ -133,18 +94,19 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     schedule.idle_spin = options.idle_spin;
     schedule.cancel = options.cancel;
     schedule.progress = options.progress;
-    std::vector<PacketWork> work(worker_count(schedule));
     // Sized here, so that workers never allocate: a thread's first allocation would create a malloc
     // arena of its own (page faults on every frame), and the hot path must not allocate.
     const auto packet_rays = static_cast<std::size_t>(options.packet) * static_cast<std::size_t>(options.packet);
-    for (PacketWork& w : work) w.reserve(packet_rays);
+    std::vector<PacketWork> work;
+    work.reserve(worker_count(schedule));
+    for (unsigned w = 0; w < worker_count(schedule); ++w) work.push_back({PacketWorkload(scene, camera, packet_rays)});
 
     Timer timer;
     std::vector<WorkerLoad> loads;
     const bool complete = run_packets(
         grid, schedule, image,
         [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
-            trace_packet(scene, accel, camera, rect, options.count, work[w], out);
+            trace_packet(scene, accel, rect, options.count, work[w], out);
         },
         &loads);
     if (!complete) throw Error("render cancelled");

@@ -95,7 +95,7 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
     const std::size_t count = grid.count();
     // A run's bounds are 32-bit, and an emptied run's begin passes its end by one.
     if (count >= std::numeric_limits<std::uint32_t>::max())
-        throw Error("a frame of " + std::to_string(count) + " packets is too many for pull dispatch: use a larger --packet");
+        throw Error("a frame of " + std::to_string(count) + " packets is too many for pull dispatch: use larger packets");
     std::vector<PacketRange> ranges(workers);
     for (unsigned w = 0; w < workers; ++w)
         ranges[w].assign(static_cast<std::uint32_t>(count * w / workers), static_cast<std::uint32_t>(count * (w + 1) / workers));
@@ -229,14 +229,15 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
 Dispatch parse_dispatch(const std::string& name) {
     if (name == "pull") return Dispatch::pull;
     if (name == "mailbox") return Dispatch::mailbox;
-    throw Error("--dispatch '" + name + "' must be pull or mailbox");
+    throw Error("dispatch mode '" + name + "' is not one of: pull, mailbox");
 }
 
 const char* to_string(Dispatch d) { return d == Dispatch::pull ? "pull" : "mailbox"; }
 
 PacketGrid::PacketGrid(int w, int h, int p) : width(w), height(h), packet(p) {
     if (w < 1 || h < 1) throw Error("image size must be positive");
-    if (p < 1 || p > 256) throw Error("--packet " + std::to_string(p) + " must lie in [1, 256]");
+    if (p < 1 || p > kMaxPacket)
+        throw Error("packet edge " + std::to_string(p) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
 }
 
 PixelRect PacketGrid::rect(std::size_t index) const {

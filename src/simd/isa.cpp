@@ -37,10 +37,10 @@ Isa parse_isa(const std::string& name) {
             if (h == isa) return isa;
         std::string list;
         for (Isa h : have) list += std::string(list.empty() ? "" : ", ") + to_string(h);
-        throw Error("--simd " + name + " is not available on this machine or in this build (available: auto, off, " +
-                    list + ")");
+        throw Error("SIMD instruction set " + name + " is not available on this machine or in this build (available: "
+                    "auto, off, " + list + ")");
     }
-    throw Error("--simd '" + name + "' must be auto, off, portable, sse, avx2 or avx512");
+    throw Error("SIMD instruction set '" + name + "' is not one of: auto, off, portable, sse, avx2, avx512");
 }
 
 }  // namespace cellrt::detail
