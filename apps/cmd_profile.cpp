@@ -150,7 +150,11 @@ int run_profile(const ProfileOptions& o) {
     AccelConfig config = o.accel.config();
     if (!hardware) {
         std::string note;
-        config = profile::config_for_callgrind(config, note);
+        try {
+            config = profile::config_for_callgrind(config, note);
+        } catch (const Error& e) {
+            throw Error(std::string("--simd: ") + e.what());
+        }
         if (!note.empty()) std::printf("%s\n", note.c_str());
     }
     const Scene scene = load_scene(o.scene);
