@@ -1,7 +1,5 @@
 #include "bih_structure.hpp"
 
-#include <cstdio>
-
 #include "kernel/param_reader.hpp"
 
 namespace cellrt::detail {
@@ -9,11 +7,7 @@ namespace {
 
 constexpr Named<BihSplit> kSplits[] = {{"global", BihSplit::global}, {"sah", BihSplit::sah}};
 
-std::string text(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
+std::string text(double v) { return param_number(v); }
 
 }  // namespace
 

@@ -4,15 +4,15 @@
 #include <cstdio>
 
 namespace cellrt {
-namespace {
 
-// Whole numbers in full (2^20 as 1048576), others as %g.
-std::string number_text(double v) {
+std::string param_number(double v) {
     char buf[32];
     if (v == std::floor(v) && std::fabs(v) < 1e15) std::snprintf(buf, sizeof buf, "%.0f", v);
     else std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
 }
+
+namespace {
 
 std::string join(const std::vector<std::string>& items) {
     std::string out;
@@ -29,9 +29,9 @@ std::string param_range(const ParamSpec& spec) {
         default: {
             // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on a chain of operator+.
             std::string range = "[";
-            range += number_text(spec.min);
+            range += param_number(spec.min);
             range += ", ";
-            range += number_text(spec.max);
+            range += param_number(spec.max);
             range += "]";
             return range;
         }

@@ -1,7 +1,5 @@
 #include "kd_structure.hpp"
 
-#include <cstdio>
-
 #include "kernel/param_reader.hpp"
 
 namespace cellrt::detail {
@@ -10,11 +8,7 @@ namespace {
 constexpr Named<KdBuildMethod> kMethods[] = {
     {"hybrid", KdBuildMethod::hybrid}, {"sweep", KdBuildMethod::sweep}, {"binned", KdBuildMethod::binned}};
 
-std::string text(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
+std::string text(double v) { return param_number(v); }
 std::string text(bool v) { return v ? "true" : "false"; }
 
 }  // namespace

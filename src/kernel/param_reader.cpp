@@ -40,7 +40,7 @@ ParamReader::ParamReader(const ParamTable& table, const AccelConfig& config, std
 }
 
 // Asking for a parameter the table lacks, or as another type, is a programming error of the structure.
-const ParamSpec& ParamReader::spec(const std::string& name, ParamType type) const {
+const ParamSpec& ParamReader::spec(const std::string& name, ParamType type) {
     for (const ParamSpec& p : table_)
         if (p.name == name && p.type == type) {
             read_.push_back(name);

@@ -29,13 +29,13 @@ public:
     void finish() const;
 
 private:
-    const ParamSpec& spec(const std::string& name, ParamType type) const;
+    const ParamSpec& spec(const std::string& name, ParamType type);
     const std::string& text(const ParamSpec& spec, const std::string* default_value) const;
 
     const ParamTable& table_;
     std::map<std::string, std::string> given_;
     std::string structure_;
-    mutable std::vector<std::string> read_;
+    std::vector<std::string> read_;  // the rows read so far
 };
 
 // The traversal `requested` among `names` (the default first), or the default when `requested` is
