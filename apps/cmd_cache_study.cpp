@@ -62,7 +62,7 @@ constexpr CacheLayout kFixedTriangleLayout{128, 128, 1};
 FrameRays sampled_frame(const Scene& scene, int width, int height, int packet, int sample) {
     const PacketGrid grid(width, height, packet);
     const auto columns = static_cast<std::size_t>(grid.columns());
-    return frame_rays(scene, width, height, packet, *make_accelerator(scene.triangles, AccelConfig{"kd"}),
+    return frame_rays(scene, width, height, packet, *make_accelerator(scene.triangles, AccelConfig{"kd"}), {},
                       [&](std::size_t p) { return (p % columns + p / columns) % static_cast<std::size_t>(sample) == 0; });
 }
 
@@ -84,8 +84,8 @@ Result trace(const LocalStoreAccelerator& base, const Run& run, const FrameRays&
     for (const FrameRays::Packet& p : w.packets) {
         hits.resize(p.primary_count);
         accel->intersect(std::span(w.primary).subspan(p.primary, p.primary_count), hits);
-        occluded.resize(p.shadow_count);
-        accel->occluded(std::span(w.shadow).subspan(p.shadow, p.shadow_count), occluded);
+        occluded.resize(p.secondary_count);
+        accel->occluded(std::span(w.secondary).subspan(p.secondary, p.secondary_count), occluded);
     }
     return {accel->local_store_stats(), timer.seconds()};
 }
@@ -249,7 +249,7 @@ Runner add_cache_study(CLI::App& app) {
                         "primary + %zu shadow rays of the frame's %llu\n",
                         scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
                         PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample, w.primary.size(),
-                        w.shadow.size(), static_cast<unsigned long long>(w.frame_ray_count));
+                        w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
             std::fflush(stdout);
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
             std::vector<Run> runs;

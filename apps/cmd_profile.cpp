@@ -194,7 +194,7 @@ int run_profile(const ProfileOptions& o) {
     counted.count = true;
     render(scene, *accel, counted, &work);
     TraversalCounters all = work.primary;
-    all += work.shadow;
+    all += work.secondary;
 
     profile::RegionCounts counts;
     if (hardware) {
@@ -208,7 +208,7 @@ int run_profile(const ProfileOptions& o) {
     }
 
     std::printf("rays                   %s primary + %s shadow = %s; native render %.4f s CPU (best of %d)\n",
-                with_commas(work.primary_rays).c_str(), with_commas(work.shadow_rays).c_str(),
+                with_commas(work.primary_rays).c_str(), with_commas(work.secondary_rays).c_str(),
                 with_commas(all.rays).c_str(), native_seconds, kTimedRenders);
     print_report(counts, all);
 
@@ -225,7 +225,7 @@ int run_profile(const ProfileOptions& o) {
                             {"packet", ro.packet},
                             {"method", hardware ? "hardware" : "callgrind"},
                             {"native_render_cpu_seconds", native_seconds}};
-        j["rays"] = {{"primary", work.primary_rays}, {"shadow", work.shadow_rays}, {"all", all.rays}};
+        j["rays"] = {{"primary", work.primary_rays}, {"shadow", work.secondary_rays}, {"all", all.rays}};
         j["work"] = {{"nodes", all.nodes},
                      {"leaves", all.leaves},
                      {"triangles", all.triangles},

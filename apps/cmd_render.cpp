@@ -1,4 +1,5 @@
-// `cellrt render [SCENE] ...`: one primary ray per pixel and one shadow ray per hit, to PNG or PFM;
+// `cellrt render [SCENE] ...`: one primary ray per pixel and the rays its shading casts (one shadow
+// ray per hit; or AO rays; or a diffuse bounce), to PNG or PFM;
 // with --local-store through the local-store model (docs/LOCALSTORE.md), whose cache statistics and
 // modelled cycles are printed at the end.
 #include <nlohmann/json.hpp>
@@ -87,6 +88,23 @@ std::unique_ptr<Accelerator> make_structure(const Scene& scene, const AccelConfi
     }
 }
 
+// --shading and --ao-samples; `ao_samples_given` is whether the user typed the latter, which means
+// nothing for another shading.
+ShadingOptions parse_shading_options(const std::string& shading, int ao_samples, const CLI::Option& ao_samples_given) {
+    ShadingOptions s;
+    try {
+        s.shading = parse_shading(shading);
+    } catch (const Error& e) {
+        throw option_error("--shading", e);
+    }
+    if (ao_samples_given.count() > 0 && s.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
+    if (ao_samples < 1 || ao_samples > kMaxAoSamples)
+        throw Error("--ao-samples " + std::to_string(ao_samples) + " must lie in [1, " + std::to_string(kMaxAoSamples) +
+                    "]");
+    s.ao_samples = ao_samples;
+    return s;
+}
+
 // Refuses at the start, before any work, to replace a file the user has.
 void check_output(const std::string& path, bool overwrite) {
     std::error_code ec;
@@ -163,20 +181,28 @@ nlohmann::json local_store_json(const LocalStoreAccelerator& accel) {
 Runner add_render(CLI::App& app) {
     struct Options {
         std::string scene = default_scene_spec();
-        std::string size, out = "cellrt.png", dispatch = "pull";
+        std::string size, out = "cellrt.png", dispatch = "pull", shading = "direct";
         bool overwrite = false, pin = false;
         int packet = RenderOptions{}.packet;
+        int ao_samples = ShadingOptions{}.ao_samples;
         AccelOptions accel;
         LocalStoreOptions local_store;
         std::string stats;
     };
     auto o = std::make_shared<Options>();
-    auto* cmd = app.add_subcommand("render", "Render a scene to an image (primary + one shadow ray per hit)");
+    auto* cmd = app.add_subcommand("render", "Render a scene to an image (primary rays and those their shading casts)");
     cmd->add_option("scene", o->scene, scene_help())->capture_default_str();
     o->accel.add_to(*cmd, false);
     cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's)");
     cmd->add_option("-o,--output", o->out, "Output image: .png (sRGB) or .pfm (exact floats)")->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace the output file if it exists");
+    cmd->add_option("--shading", o->shading,
+                    "direct: one shadow ray per hit (the study's); ao: ambient occlusion; diffuse: one bounce lit "
+                    "by the light")
+        ->capture_default_str();
+    auto* ao_samples = cmd->add_option("--ao-samples", o->ao_samples, "AO rays per hit (1.." +
+                                       std::to_string(kMaxAoSamples) + "), with --shading ao")
+                           ->capture_default_str();
     cmd->add_option("--packet", o->packet, "Packet edge P: workers trace P x P rays at a time")->capture_default_str();
     cmd->add_option("--dispatch", o->dispatch,
                     "How packets reach workers: pull (each worker a run of packets, stealing when done) or "
@@ -185,7 +211,8 @@ Runner add_render(CLI::App& app) {
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
     cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE");
-    return [o] {
+    return [o, ao_samples] {
+        const ShadingOptions shading = parse_shading_options(o->shading, o->ao_samples, *ao_samples);
         if (o->packet < 1 || o->packet > kMaxPacket)
             throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
         const LocalStoreConfig local_store = o->local_store.config(o->packet);
@@ -200,6 +227,7 @@ Runner add_render(CLI::App& app) {
         if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o->size);
         ro.threads = o->accel.threads;
         ro.packet = o->packet;
+        ro.shading = shading;
         try {
             ro.dispatch = parse_dispatch(o->dispatch);
         } catch (const Error& e) {
@@ -225,14 +253,15 @@ Runner add_render(CLI::App& app) {
         std::printf("%s: %zu triangles, %dx%d, %s, load %.3f s, build %.3f s, render %.3f s (%.2f Mrays/s) -> %s\n",
                     scene.name.c_str(), scene.triangles.size(), ro.width, ro.height, st.name.c_str(), load_s,
                     st.build_seconds, rs.seconds,
-                    static_cast<double>(rs.primary_rays + rs.shadow_rays) / rs.seconds * 1e-6, o->out.c_str());
+                    static_cast<double>(rs.primary_rays + rs.secondary_rays) / rs.seconds * 1e-6, o->out.c_str());
         if (modelled) print_local_store(*modelled);
         if (!o->stats.empty()) {
             nlohmann::json j = {{"scene", scene.name},          {"triangles", scene.triangles.size()},
                                 {"width", ro.width},            {"height", ro.height},
                                 {"structure", st.name},         {"threads", ro.threads},
                                 {"packet", ro.packet},          {"primary_rays", rs.primary_rays},
-                                {"shadow_rays", rs.shadow_rays}, {"build_seconds", st.build_seconds},
+                                {"shading", to_string(shading.shading)}, {"secondary_rays", rs.secondary_rays},
+                                {"build_seconds", st.build_seconds},
                                 {"render_seconds", rs.seconds}, {"figures", nlohmann::json::object()}};
             for (const auto& [k, v] : st.figures()) j["figures"][k] = v;
             // Each worker's share of the frame (docs/SCALING.md): the packets it traced, the time it

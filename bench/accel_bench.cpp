@@ -1,9 +1,12 @@
 // Structures against Embree, in the same run on the same rays: build time, memory and rays per second
-// of primary and shadow rays for every structure and traversal, per scene.
+// of primary rays and of a second kind of rays for every structure and traversal, per scene.
 //
-// The rays of a scene are those of one frame at the view's size: one primary ray per pixel, in 16 x 16
-// packets in the order the renderer traces them, and one shadow ray toward the light per primary hit
-// (hits found by an exact structure, so every configuration traces the very same shadow rays).
+// The rays of a scene (--rays) are those of one frame at the view's size: one primary ray per pixel, in
+// 16 x 16 packets in the order the renderer traces them, and the rays the renderer casts from their
+// hits (workload.hpp): `frame`, one shadow ray toward the light per hit; `ao`, --ao-samples AO rays per
+// hit (any hit); `diffuse`, one cosine-weighted bounce per hit (closest hit). The hits are found by an
+// exact structure, so every configuration traces the very same rays. `random` rays are incoherent:
+// origins in the scene's box, directions uniform. The second kind is reported in the shadow_* fields.
 // Each configuration is built `--builds` times (median reported); then, after a warm-up pass each,
 // the configurations are traced in turn, `--repeats` rounds (median per ray kind), single-threaded
 // unless `--threads` says otherwise.
@@ -21,6 +24,7 @@
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
+#include "cellrt/sampling.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/timer.hpp"
 #include "cellrt/workload.hpp"
@@ -30,15 +34,17 @@ namespace {
 using namespace cellrt;
 using bench::median;
 
-// The rays every configuration traces.
+// The rays every configuration traces: primary rays (closest hit), and rays of a second kind, any hit
+// or closest hit as the kind asks.
 struct Rays {
-    std::vector<Ray> primary, shadow;
+    std::vector<Ray> primary, secondary;
+    RayKind secondary_kind = RayKind::shadow;
 };
 
 // The frame workload in 16 x 16 packets, the hits found by `exact` (workload.hpp).
-Rays frame(const Scene& scene, const Accelerator& exact, int width, int height) {
-    FrameRays f = frame_rays(scene, width, height, 16, exact);
-    return {std::move(f.primary), std::move(f.shadow)};
+Rays frame(const Scene& scene, const Accelerator& exact, int width, int height, const ShadingOptions& shading) {
+    FrameRays f = frame_rays(scene, width, height, 16, exact, shading);
+    return {std::move(f.primary), std::move(f.secondary), f.secondary_kind};
 }
 
 // Incoherent rays, for the packet kernels' worst case: origins uniform in the scene's box,
@@ -47,12 +53,7 @@ Rays frame(const Scene& scene, const Accelerator& exact, int width, int height) 
 Rays random_rays(const Scene& scene, std::size_t n) {
     const Box3 b = scene.bounds();
     std::uint64_t state = 0x9e3779b97f4a7c15ull;
-    auto next = [&] {
-        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return static_cast<float>((z ^ (z >> 31)) >> 40) / static_cast<float>(1 << 24);
-    };
+    auto next = [&] { return unit_float(mix64(state += 0x9e3779b97f4a7c15ull)); };
     Rays f;
     while (f.primary.size() < n) {
         Ray r;
@@ -62,7 +63,7 @@ Rays random_rays(const Scene& scene, std::size_t n) {
         r.dir = normalize(d);
         f.primary.push_back(r);
         r.tfar = length(b.extent()) / 3.f;
-        f.shadow.push_back(r);
+        f.secondary.push_back(r);
     }
     return f;
 }
@@ -72,7 +73,7 @@ struct Options {
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
     std::vector<std::string> configs{"embree:single", "embree:packet16", "kd:rec", "kd:branched", "kd:branchless",
                                      "kd+auto", "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"};
-    int repeats = 5, builds = 3, batch = 256;
+    int repeats = 5, builds = 3, batch = 256, ao_samples = ShadingOptions{}.ao_samples;
     unsigned threads = 1;
     std::string size, json_path, clock = "wall", ray_kind = "frame";
 };
@@ -90,9 +91,14 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--threads", o.threads, "Build threads (tracing is single-threaded)")->capture_default_str();
     app.add_option("--size", o.size, "Image size WxH (default: the view file's)");
     app.add_option("--json", o.json_path, "Write every result as JSON");
-    app.add_option("--rays", o.ray_kind, "frame: a frame's primary and shadow rays; random: incoherent rays")
+    app.add_option("--rays", o.ray_kind,
+                   "frame: a frame's primary and shadow rays; ao: its primary and AO rays; diffuse: its primary "
+                   "rays and one bounce per hit; random: incoherent rays")
         ->capture_default_str()
-        ->check(CLI::IsMember({"frame", "random"}));
+        ->check(CLI::IsMember({"frame", "ao", "diffuse", "random"}));
+    app.add_option("--ao-samples", o.ao_samples, "AO rays per primary hit (--rays ao)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxAoSamples));
     app.add_option("--clock", o.clock, "Time tracing by the wall clock or this thread's CPU clock")
         ->capture_default_str()
         ->check(CLI::IsMember({"wall", "cpu"}));
@@ -104,19 +110,54 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     return std::nullopt;
 }
 
-// A scene's rays of `kind` and the exact closest hits of its primary rays, from a kd-tree that is gone
+// What an accelerator answers for a set of rays: their closest hits, or whether each is occluded.
+struct Answers {
+    std::vector<Hit> hits;
+    std::vector<std::uint8_t> occluded;
+};
+
+// Answers `rays` as their kind asks (closest hit or any hit) in batches of `batch` rays, one
+// accelerator call each, adding the work to `counters` where given.
+void answer(const Accelerator& accel, std::span<const Ray> rays, RayKind kind, std::size_t batch, Answers& out,
+            TraversalCounters* counters = nullptr) {
+    const bool closest = closest_hit(kind);
+    if (closest) out.hits.resize(rays.size());
+    else out.occluded.resize(rays.size());
+    for (std::size_t i = 0; i < rays.size(); i += batch) {
+        const std::size_t n = std::min(batch, rays.size() - i);
+        if (closest) accel.intersect(rays.subspan(i, n), std::span(out.hits).subspan(i, n), counters);
+        else accel.occluded(rays.subspan(i, n), std::span(out.occluded).subspan(i, n), counters);
+    }
+}
+
+// The answers in `a` and `b` that differ: the triangle hit, or occluded or not.
+std::size_t differing(const Answers& a, const Answers& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < a.hits.size(); ++i) n += a.hits[i].prim != b.hits[i].prim;
+    for (std::size_t i = 0; i < a.occluded.size(); ++i) n += a.occluded[i] != b.occluded[i];
+    return n;
+}
+
+// A scene's rays of `kind` and a kd-tree's exact answers for both sets, from a kd-tree that is gone
 // before the configurations are built.
 struct SceneRays {
     Rays rays;
-    std::vector<Hit> exact;
+    Answers primary, secondary;
 };
 
-SceneRays scene_rays(const Scene& scene, const std::string& kind, int width, int height) {
+SceneRays scene_rays(const Scene& scene, const Options& o, int width, int height) {
     const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
     SceneRays s;
-    s.rays = kind == "frame" ? frame(scene, *kd, width, height) : random_rays(scene, static_cast<std::size_t>(width) * height);
-    s.exact.resize(s.rays.primary.size());
-    kd->intersect(s.rays.primary, s.exact);
+    if (o.ray_kind == "random") {
+        s.rays = random_rays(scene, static_cast<std::size_t>(width) * height);
+    } else {
+        ShadingOptions shading;
+        shading.shading = o.ray_kind == "frame" ? Shading::direct : parse_shading(o.ray_kind);
+        shading.ao_samples = o.ao_samples;
+        s.rays = frame(scene, *kd, width, height, shading);
+    }
+    answer(*kd, s.rays.primary, RayKind::primary, s.rays.primary.size(), s.primary);
+    answer(*kd, s.rays.secondary, s.rays.secondary_kind, s.rays.secondary.size(), s.secondary);
     return s;
 }
 
@@ -124,7 +165,7 @@ struct Result {
     std::string config;
     bool embree = false;
     double build_s = 0, memory_mib = 0, primary_s = 0, shadow_s = 0;
-    std::size_t differing = 0;  // primary hits that differ from the exact answer
+    std::size_t differing = 0, differing_secondary = 0;  // answers that differ from the exact ones
     TraversalCounters primary_work, shadow_work;
 };
 
@@ -174,29 +215,21 @@ double now(bool cpu_clock) {
     return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// Times one pass over `rays` in batches of `batch` rays (one accelerator call each).
-template <class Call>
-double timed_pass(std::size_t n, std::size_t batch, bool cpu_clock, Call&& call) {
-    const double start = now(cpu_clock);
-    for (std::size_t i = 0; i < n; i += batch) call(i, std::min(batch, n - i));
-    return now(cpu_clock) - start;
-}
-
 // After a warm-up pass each, the timed passes go round the configurations (primary and shadow rays
 // of each in turn, --repeats rounds), so that a slow spell of a shared machine falls on all of them
 // alike and the ratios hold.
 void timed_passes(std::vector<Entry>& entries, const Rays& rays, const Options& o) {
-    std::vector<Hit> hits(rays.primary.size());
-    std::vector<std::uint8_t> occluded(rays.shadow.size());
+    Answers primary, secondary;
     const std::size_t bs = static_cast<std::size_t>(o.batch);
     const bool cpu = o.clock == "cpu";
+    auto timed = [&](const Accelerator& accel, std::span<const Ray> r, RayKind kind, Answers& out) {
+        const double start = now(cpu);
+        answer(accel, r, kind, bs, out);
+        return now(cpu) - start;
+    };
     auto passes = [&](Entry& e) {
-        const double tp = timed_pass(rays.primary.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
-            e.accel->intersect(std::span(rays.primary).subspan(i, n), std::span(hits).subspan(i, n));
-        });
-        const double ts = timed_pass(rays.shadow.size(), bs, cpu, [&](std::size_t i, std::size_t n) {
-            e.accel->occluded(std::span(rays.shadow).subspan(i, n), std::span(occluded).subspan(i, n));
-        });
+        const double tp = timed(*e.accel, rays.primary, RayKind::primary, primary);
+        const double ts = timed(*e.accel, rays.secondary, rays.secondary_kind, secondary);
         return std::pair{tp, ts};
     };
     for (Entry& e : entries) passes(e);  // warm-up
@@ -208,19 +241,19 @@ void timed_passes(std::vector<Entry>& entries, const Rays& rays, const Options& 
         }
 }
 
-// Each configuration's median times, its work per ray and how many of its primary hits differ from
-// the exact ones; the structures are freed on the way.
-std::vector<Result> results_of(std::vector<Entry>& entries, const Rays& rays, const std::vector<Hit>& exact) {
-    std::vector<Hit> hits(rays.primary.size());
-    std::vector<std::uint8_t> occluded(rays.shadow.size());
+// Each configuration's median times, its work per ray and how many of its answers differ from the
+// exact ones; the structures are freed on the way.
+std::vector<Result> results_of(std::vector<Entry>& entries, const SceneRays& s) {
     std::vector<Result> results;
     for (Entry& e : entries) {
         Result& r = e.r;
         r.primary_s = median(e.primary_s);
         r.shadow_s = median(e.shadow_s);
-        e.accel->intersect(rays.primary, hits, &r.primary_work);
-        e.accel->occluded(rays.shadow, occluded, &r.shadow_work);
-        for (std::size_t i = 0; i < hits.size(); ++i) r.differing += !(hits[i].prim == exact[i].prim);
+        Answers primary, secondary;
+        answer(*e.accel, s.rays.primary, RayKind::primary, s.rays.primary.size(), primary, &r.primary_work);
+        answer(*e.accel, s.rays.secondary, s.rays.secondary_kind, s.rays.secondary.size(), secondary, &r.shadow_work);
+        r.differing = differing(primary, s.primary);
+        r.differing_secondary = differing(secondary, s.secondary);
         results.push_back(r);
         e.accel.reset();
     }
@@ -230,7 +263,7 @@ std::vector<Result> results_of(std::vector<Entry>& entries, const Rays& rays, co
 // The scene's table, with ratios to Embree in this run: builds to its first configuration (its
 // default build), rays per second to rtcIntersect1 (`embree:single`) and to its fastest configuration.
 void print_table(const std::vector<Result>& results, const Rays& rays) {
-    const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.shadow.size());
+    const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.secondary.size());
     auto total = [&](const Result& r) { return (np + ns) / (r.primary_s + r.shadow_s) * 1e-6; };
     const Result *first = nullptr, *single = nullptr, *best = nullptr;
     for (const Result& r : results) {
@@ -239,9 +272,11 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
         if (r.config == "embree:single" || r.config == "embree") single = &r;
         if (!best || total(r) > total(*best)) best = &r;
     }
-    std::printf("| config | build ms | build ÷ Embree | memory MiB | primary Mrays/s | shadow Mrays/s | "
-                "total Mrays/s | × Embree 1 | × Embree best | hits ≠ exact | nodes/leaves/tris per primary "
-                "ray | per shadow ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    const char* second = to_string(rays.secondary_kind);
+    std::printf("| config | build ms | build ÷ Embree | memory MiB | primary Mrays/s | %s Mrays/s | "
+                "total Mrays/s | × Embree 1 | × Embree best | answers ≠ exact | nodes/leaves/tris per primary "
+                "ray | per %s ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                second, second);
     auto ratio = [](const Result* y, double value, double of_y) {
         if (!y) return std::string("–");
         char buf[32];
@@ -250,31 +285,37 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
     };
     for (const Result& r : results) {
         const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
-        std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | %.1f / "
-                    "%.1f / %.1f |\n",
+        std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | "
+                    "%.1f / %.1f / %.1f |\n",
                     r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
                     r.memory_mib, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
                     ratio(single, total(r), single ? total(*single) : 1).c_str(),
-                    ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing, per_ray(pw.nodes, pw),
+                    ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing + r.differing_secondary,
+                    per_ray(pw.nodes, pw),
                     per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
                     per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
     }
 }
 
-nlohmann::json json_row(const Scene& scene, int width, int height, const Rays& rays, const Result& r) {
+nlohmann::json json_row(const Scene& scene, int width, int height, const Options& o, const Rays& rays,
+                        const Result& r) {
     const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
     return {{"scene", scene.name},
             {"config", r.config},
+            {"rays", o.ray_kind},
+            {"shadow_kind", to_string(rays.secondary_kind)},
+            {"ao_samples", o.ray_kind == "ao" ? o.ao_samples : 0},
             {"width", width},
             {"height", height},
             {"triangles", scene.triangles.size()},
             {"primary_rays", rays.primary.size()},
-            {"shadow_rays", rays.shadow.size()},
+            {"shadow_rays", rays.secondary.size()},
             {"build_seconds", r.build_s},
             {"memory_mib", r.memory_mib},
             {"primary_seconds", r.primary_s},
             {"shadow_seconds", r.shadow_s},
             {"differing_primary_hits", r.differing},
+            {"differing_shadow_answers", r.differing_secondary},
             {"primary_per_ray", {{"nodes", per_ray(pw.nodes, pw)}, {"leaves", per_ray(pw.leaves, pw)},
                                  {"triangles", per_ray(pw.triangles, pw)}}},
             {"shadow_per_ray", {{"nodes", per_ray(sw.nodes, sw)}, {"leaves", per_ray(sw.leaves, sw)},
@@ -284,15 +325,16 @@ nlohmann::json json_row(const Scene& scene, int width, int height, const Rays& r
 // One scene: its rays, every configuration built and timed, its table; its JSON rows go to `out`.
 void bench_scene(const Scene& scene, const Options& o, nlohmann::json& out) {
     const auto [w, h] = o.size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", o.size);
-    const SceneRays s = scene_rays(scene, o.ray_kind, w, h);
-    std::printf("\n### %s: %zu triangles, %dx%d, %zu primary + %zu shadow rays\n\n", scene.name.c_str(),
-                scene.triangles.size(), w, h, s.rays.primary.size(), s.rays.shadow.size());
+    const SceneRays s = scene_rays(scene, o, w, h);
+    std::printf("\n### %s: %zu triangles, %dx%d, %s rays: %zu primary + %zu %s\n\n", scene.name.c_str(),
+                scene.triangles.size(), w, h, o.ray_kind.c_str(), s.rays.primary.size(), s.rays.secondary.size(),
+                to_string(s.rays.secondary_kind));
     std::vector<Entry> entries = build_configurations(scene, o);
     timed_passes(entries, s.rays, o);
-    const std::vector<Result> results = results_of(entries, s.rays, s.exact);
+    const std::vector<Result> results = results_of(entries, s);
     std::fprintf(stderr, "%s done\n", scene.name.c_str());
     print_table(results, s.rays);
-    for (const Result& r : results) out.push_back(json_row(scene, w, h, s.rays, r));
+    for (const Result& r : results) out.push_back(json_row(scene, w, h, o, s.rays, r));
     std::fflush(stdout);
 }
 

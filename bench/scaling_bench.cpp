@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
                                 median_of_rounds(repeats, [&](std::size_t r) { return busy[w][r] / busy[first][r]; });
                             points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), median(busy[w]),
                                               median(started[w]), median(waiting[w]), efficiency, packet_time_ratio,
-                                              st.primary_rays + st.shadow_rays});
+                                              st.primary_rays + st.secondary_rays});
                             std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
                                          cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
                         }

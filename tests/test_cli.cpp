@@ -78,33 +78,61 @@ TEST(Cli, InterruptedRenderLeavesNoFile) {
     }
 }
 
-// Every path through the program gives the same bits: structures, SIMD, traversals, dispatch modes,
-// worker counts and packet sizes (including packets that do not divide the image).
+// Every path through the program gives the same bits, under every shading: structures, SIMD,
+// traversals, dispatch modes, worker counts and packet sizes (including packets that do not divide the
+// image).
 TEST(Cli, SameImageForEveryPath) {
     TempDir dir;
     const std::string scene = "builtin:spheres?tris=3000";
+    for (const std::vector<std::string>& shading : std::vector<std::vector<std::string>>{
+             {"--shading", "direct"}, {"--shading", "ao", "--ao-samples", "3"}, {"--shading", "diffuse"}}) {
+        auto render = [&](const std::string& name, std::vector<std::string> extra) {
+            const fs::path out = dir.path / (name + "_" + shading[1] + ".pfm");
+            std::vector<std::string> args{"render", scene, "--size", "67x45", "-o", out.string()};
+            args.insert(args.end(), shading.begin(), shading.end());
+            args.insert(args.end(), extra.begin(), extra.end());
+            EXPECT_EQ(run(args), 0) << name << " " << shading[1];
+            return read_pfm(out.string());
+        };
+        const Image reference = render("brute", {"--accel", "brute", "--simd", "off", "--threads", "1"});
+        const std::vector<std::pair<std::string, std::vector<std::string>>> paths = {
+            {"kd_auto", {"--accel", "kd"}},
+            {"kd_rec", {"--accel", "kd", "--traversal", "rec", "--threads", "3", "--packet", "5"}},
+            {"kd_branchless_mailbox", {"--accel", "kd", "--traversal", "branchless", "--dispatch", "mailbox", "--packet", "2"}},
+            {"bih_auto_mailbox", {"--accel", "bih", "--dispatch", "mailbox", "--threads", "2", "--packet", "16"}},
+            {"bih_branched", {"--accel", "bih", "--traversal", "branched", "--packet", "1"}},
+            {"kd_portable", {"--accel", "kd", "--simd", "portable", "--packet", "7"}},
+            {"brute_auto", {"--accel", "brute", "--packet", "8"}},
+        };
+        for (const auto& [name, extra] : paths) {
+            const Image img = render(name, extra);
+            ASSERT_EQ(img.pixels.size(), reference.pixels.size()) << name;
+            EXPECT_EQ(std::memcmp(img.pixels.data(), reference.pixels.data(), img.pixels.size() * sizeof(Vec3)), 0)
+                << name << " " << shading[1];
+        }
+    }
+}
+
+// The shadings differ from one another, and AO with more samples is another image: the options reach
+// the renderer.
+TEST(Cli, ShadingsGiveTheirOwnImages) {
+    TempDir dir;
     auto render = [&](const std::string& name, std::vector<std::string> extra) {
         const fs::path out = dir.path / (name + ".pfm");
-        std::vector<std::string> args{"render", scene, "--size", "67x45", "-o", out.string()};
+        std::vector<std::string> args{"render", "builtin:spheres?tris=3000", "--size", "40x30", "-o", out.string()};
         args.insert(args.end(), extra.begin(), extra.end());
         EXPECT_EQ(run(args), 0) << name;
         return read_pfm(out.string());
     };
-    const Image reference = render("brute", {"--accel", "brute", "--simd", "off", "--threads", "1"});
-    const std::vector<std::pair<std::string, std::vector<std::string>>> paths = {
-        {"kd_auto", {"--accel", "kd"}},
-        {"kd_rec", {"--accel", "kd", "--traversal", "rec", "--threads", "3", "--packet", "5"}},
-        {"kd_branchless_mailbox", {"--accel", "kd", "--traversal", "branchless", "--dispatch", "mailbox", "--packet", "2"}},
-        {"bih_auto_mailbox", {"--accel", "bih", "--dispatch", "mailbox", "--threads", "2", "--packet", "16"}},
-        {"bih_branched", {"--accel", "bih", "--traversal", "branched", "--packet", "1"}},
-        {"kd_portable", {"--accel", "kd", "--simd", "portable", "--packet", "7"}},
-        {"brute_auto", {"--accel", "brute", "--packet", "8"}},
-    };
-    for (const auto& [name, extra] : paths) {
-        const Image img = render(name, extra);
-        ASSERT_EQ(img.pixels.size(), reference.pixels.size()) << name;
-        EXPECT_EQ(std::memcmp(img.pixels.data(), reference.pixels.data(), img.pixels.size() * sizeof(Vec3)), 0) << name;
-    }
+    const std::vector<Image> images = {render("direct", {}), render("ao", {"--shading", "ao"}),
+                                       render("ao8", {"--shading", "ao", "--ao-samples", "8"}),
+                                       render("diffuse", {"--shading", "diffuse"})};
+    for (std::size_t a = 0; a < images.size(); ++a)
+        for (std::size_t b = a + 1; b < images.size(); ++b)
+            EXPECT_NE(std::memcmp(images[a].pixels.data(), images[b].pixels.data(),
+                                  images[a].pixels.size() * sizeof(Vec3)),
+                      0)
+                << a << " " << b;
 }
 
 TEST(Cli, RefusesBadOptions) {
@@ -118,6 +146,9 @@ TEST(Cli, RefusesBadOptions) {
              {"render", "--accel", "kd", "-P", "bins=1", "-o", out},
              {"render", "--accel", "bih", "--traversal", "rec", "-o", out},
              {"render", "--size", "0x5", "-o", out},
+             {"render", "--shading", "phong", "-o", out},
+             {"render", "--shading", "ao", "--ao-samples", "0", "-o", out},
+             {"render", "--ao-samples", "4", "-o", out},
              {"render", "-o", (dir.path / "no" / "such" / "x.png").string()},
          }) {
         EXPECT_NE(run(args), 0) << args[1] << " " << args[2];
@@ -137,6 +168,9 @@ TEST(Cli, NamesTheOptionAtFault) {
              {{"render", "--simd", "avx9", "-o", out},
               "--simd: SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
              {{"render", "-o", existing}, existing + ": file exists (pass --overwrite to replace it)"},
+             {{"render", "--shading", "phong", "-o", out}, "--shading: shading 'phong' is not one of: direct, ao, diffuse"},
+             {{"render", "--shading", "ao", "--ao-samples", "65", "-o", out}, "--ao-samples 65 must lie in [1, 64]"},
+             {{"render", "--ao-samples", "4", "-o", out}, "--ao-samples needs --shading ao"},
          }) {
         std::vector<std::string> all{CELLRT_CLI};
         all.insert(all.end(), args.begin(), args.end());

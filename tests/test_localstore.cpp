@@ -323,7 +323,7 @@ TEST(LocalStoreModel, ImagesBitIdenticalToDirectMemory) {
             EXPECT_TRUE(same_bits(render(scene, *accel, small_render(2), &rs), direct))
                 << structure << " through " << describe(c);
             const LocalStoreStats s = accel->local_store_stats();
-            EXPECT_EQ(s.rays, rs.primary_rays + rs.shadow_rays);
+            EXPECT_EQ(s.rays, rs.primary_rays + rs.secondary_rays);
             EXPECT_GT(s.cycles, s.stall_cycles);
             EXPECT_GE(s.cycles, s.frame_cycles);
         }
@@ -488,7 +488,7 @@ TEST(LocalStoreCli, RendersTheSameImageAndReportsTheModel) {
     EXPECT_EQ(ls.at("triangle_cache").at("layout"), "32x8");
     EXPECT_EQ(ls.at("access"), "async");
     EXPECT_EQ(ls.at("rays").get<std::uint64_t>(),
-              j.at("primary_rays").get<std::uint64_t>() + j.at("shadow_rays").get<std::uint64_t>());
+              j.at("primary_rays").get<std::uint64_t>() + j.at("secondary_rays").get<std::uint64_t>());
     EXPECT_GT(ls.at("cycles").get<std::uint64_t>(), 0u);
     EXPECT_GT(ls.at("node_cache").at("prefetches").get<std::uint64_t>(), 0u);
     // Both workers' loads: together they traced the 5 x 4 packets of 8 x 8 pixels.

@@ -452,10 +452,10 @@ TEST(ProfileCli, ReportsBothRegionsAndTheKernelsWork) {
     RenderStats st;
     render(scene, *accel, o, &st);
     EXPECT_EQ(j["rays"]["primary"], 24u * 16u);
-    EXPECT_EQ(j["rays"]["shadow"], st.shadow_rays);
-    EXPECT_EQ(j["work"]["nodes"], st.primary.nodes + st.shadow.nodes);
-    EXPECT_EQ(j["work"]["leaves"], st.primary.leaves + st.shadow.leaves);
-    EXPECT_EQ(j["work"]["triangles"], st.primary.triangles + st.shadow.triangles);
+    EXPECT_EQ(j["rays"]["shadow"], st.secondary_rays);
+    EXPECT_EQ(j["work"]["nodes"], st.primary.nodes + st.secondary.nodes);
+    EXPECT_EQ(j["work"]["leaves"], st.primary.leaves + st.secondary.leaves);
+    EXPECT_EQ(j["work"]["triangles"], st.primary.triangles + st.secondary.triangles);
     // The traversal is part of the render, and costs something.
     const auto& whole = j["regions"]["render"];
     const auto& trav = j["regions"]["traversal"];

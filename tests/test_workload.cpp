@@ -1,15 +1,20 @@
 // The frame workload (workload.hpp): a packet's primary rays are the camera's rays of its pixels in
-// packet order, each hit casts one shadow ray and a miss none; the renderer traces exactly the rays
-// frame_rays() collects for the benchmark and the cache study.
+// packet order; under direct shading each hit casts one shadow ray and a miss none; under AO N
+// cosine-weighted rays about the normal; under diffuse a shadow ray and a bounce, and each bounce's
+// hit a shadow ray. A pixel's rays do not depend on the packet size; the renderer traces exactly the
+// rays frame_rays() collects for the benchmark and the cache study.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <vector>
 
 #include "cellrt/builtin.hpp"
+#include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
+#include "cellrt/sampling.hpp"
 #include "cellrt/workload.hpp"
 
 namespace cellrt {
@@ -22,6 +27,13 @@ bool same_rays(std::span<const Ray> a, std::span<const Ray> b) {
 // A size whose edge packets are cut on both sides, so partial packets are covered.
 constexpr int kWidth = 37, kHeight = 29, kPacket = 8;
 
+ShadingOptions shading_of(Shading s, int ao_samples = 4) {
+    ShadingOptions o;
+    o.shading = s;
+    o.ao_samples = ao_samples;
+    return o;
+}
+
 TEST(Workload, PrimaryRaysAreTheCamerasInPacketOrderAndEveryHitCastsOneShadowRay) {
     const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
     const auto accel = make_accelerator(scene.triangles, AccelConfig{"brute"});
@@ -33,6 +45,7 @@ TEST(Workload, PrimaryRaysAreTheCamerasInPacketOrderAndEveryHitCastsOneShadowRay
         const PixelRect rect = grid.rect(p);
         TraversalCounters primary, shadow;
         work.trace(rect, *accel, &primary, &shadow);
+        const RayBatch prim = work.batch(RayKind::primary), sh = work.batch(RayKind::shadow);
 
         std::vector<std::uint32_t> order(static_cast<std::size_t>(rect.pixels()));
         packet_order(rect, order);
@@ -41,10 +54,10 @@ TEST(Workload, PrimaryRaysAreTheCamerasInPacketOrderAndEveryHitCastsOneShadowRay
         for (const std::uint32_t o : order)
             expected.push_back(camera.primary(rect.x0 + static_cast<int>(o) % rect.width(),
                                               rect.y0 + static_cast<int>(o) / rect.width()));
-        ASSERT_TRUE(same_rays(work.primary(), expected)) << "packet " << p;
+        ASSERT_TRUE(same_rays(prim.rays, expected)) << "packet " << p;
         std::vector<Hit> expected_hits(expected.size());
         accel->intersect(expected, expected_hits);
-        ASSERT_TRUE(std::equal(expected_hits.begin(), expected_hits.end(), work.hits().begin(), work.hits().end()));
+        ASSERT_TRUE(std::equal(expected_hits.begin(), expected_hits.end(), prim.hits.begin(), prim.hits.end()));
         EXPECT_EQ(primary.rays, expected.size());
 
         // One shadow ray per hit, in the primary rays' order, none for a miss.
@@ -59,18 +72,155 @@ TEST(Workload, PrimaryRaysAreTheCamerasInPacketOrderAndEveryHitCastsOneShadowRay
             const SurfacePoint sp = surface_point(scene.triangles[expected_hits[i].prim], expected[i], expected_hits[i]);
             expected_shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
             expected_primary.push_back(static_cast<std::uint32_t>(i));
-            EXPECT_EQ(work.normals()[expected_shadow.size() - 1], sp.normal);
+            EXPECT_EQ(sh.normals[expected_shadow.size() - 1], sp.normal);
         }
-        ASSERT_TRUE(same_rays(work.shadow(), expected_shadow)) << "packet " << p;
-        EXPECT_TRUE(std::equal(expected_primary.begin(), expected_primary.end(), work.shadow_primary().begin(),
-                               work.shadow_primary().end()));
+        ASSERT_TRUE(same_rays(sh.rays, expected_shadow)) << "packet " << p;
+        EXPECT_TRUE(std::equal(expected_primary.begin(), expected_primary.end(), sh.parent.begin(), sh.parent.end()));
         EXPECT_EQ(shadow.rays, expected_shadow.size());
         std::vector<std::uint8_t> occluded(expected_shadow.size());
         accel->occluded(expected_shadow, occluded);
-        EXPECT_TRUE(std::equal(occluded.begin(), occluded.end(), work.occluded().begin(), work.occluded().end()));
+        EXPECT_TRUE(std::equal(occluded.begin(), occluded.end(), sh.occluded.begin(), sh.occluded.end()));
     }
     EXPECT_GT(hits, 0u);
     EXPECT_GT(misses, 0u) << "the scene must show some sky";
+}
+
+// Under AO, each hit casts --ao-samples rays, consecutive, from the shadow ray's origin, about the
+// normal, reaching a tenth of the scene's diagonal; their cosines to the normal average 2/3, as a
+// cosine-weighted hemisphere's do (a uniform hemisphere's average 1/2).
+TEST(Workload, AoRaysAreCosineWeightedAboutTheNormalWithAFixedReach) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    const PinholeCamera camera(scene.camera, kWidth, kHeight);
+    const PacketGrid grid(kWidth, kHeight, kPacket);
+    const int n = 5;
+    PacketWorkload work(scene, camera, kPacket * kPacket, shading_of(Shading::ao, n));
+    const float reach = kAoReachFraction * length(scene.bounds().extent());
+    double cosines = 0;
+    std::size_t rays = 0;
+    for (std::size_t p = 0; p < grid.count(); ++p) {
+        work.trace(grid.rect(p), *accel);
+        const RayBatch prim = work.batch(RayKind::primary), ao = work.batch(RayKind::ao);
+        EXPECT_TRUE(work.batch(RayKind::shadow).rays.empty());
+        const auto hits = static_cast<std::size_t>(std::count_if(prim.hits.begin(), prim.hits.end(),
+                                                                 [](const Hit& h) { return h.is_hit(); }));
+        ASSERT_EQ(ao.rays.size(), hits * n) << p;
+        ASSERT_EQ(ao.occluded.size(), ao.rays.size());
+        for (std::size_t k = 0; k < ao.rays.size(); ++k) {
+            const std::uint32_t i = ao.parent[k];
+            ASSERT_EQ(i, ao.parent[k - k % n]) << "the rays of a hit are consecutive";
+            const SurfacePoint sp = surface_point(scene.triangles[prim.hits[i].prim], prim.rays[i], prim.hits[i]);
+            EXPECT_EQ(ao.normals[k], sp.normal);
+            EXPECT_EQ(ao.rays[k].org, offset_ray_origin(sp.position, sp.normal));
+            EXPECT_EQ(ao.rays[k].tnear, 0.f);
+            EXPECT_EQ(ao.rays[k].tfar, reach);
+            EXPECT_NEAR(length(ao.rays[k].dir), 1.f, 1e-5f);
+            EXPECT_GE(dot(ao.rays[k].dir, sp.normal), -1e-6f);
+            cosines += dot(ao.rays[k].dir, sp.normal);
+            ++rays;
+        }
+    }
+    ASSERT_GT(rays, 1000u);
+    EXPECT_NEAR(cosines / static_cast<double>(rays), 2.0 / 3.0, 0.02);
+}
+
+// Under diffuse shading each hit casts a shadow ray (as under direct) and one bounce, closest hit;
+// each bounce that hits casts a shadow ray from its hit.
+TEST(Workload, DiffuseRaysAreAShadowRayAndABounceAndTheBouncesShadowRays) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    const PinholeCamera camera(scene.camera, kWidth, kHeight);
+    const PacketGrid grid(kWidth, kHeight, kPacket);
+    PacketWorkload work(scene, camera, kPacket * kPacket, shading_of(Shading::diffuse));
+    std::size_t bounce_hits = 0;
+    for (std::size_t p = 0; p < grid.count(); ++p) {
+        work.trace(grid.rect(p), *accel);
+        const RayBatch prim = work.batch(RayKind::primary), sh = work.batch(RayKind::shadow),
+                       bounce = work.batch(RayKind::bounce), bs = work.batch(RayKind::bounce_shadow);
+        ASSERT_EQ(bounce.rays.size(), sh.rays.size());
+        ASSERT_EQ(bounce.hits.size(), bounce.rays.size());
+        std::vector<Ray> expected_bs;
+        for (std::size_t k = 0; k < bounce.rays.size(); ++k) {
+            const std::uint32_t i = bounce.parent[k];
+            EXPECT_EQ(sh.parent[k], i);
+            const SurfacePoint sp = surface_point(scene.triangles[prim.hits[i].prim], prim.rays[i], prim.hits[i]);
+            EXPECT_EQ(sh.rays[k].org, shadow_ray(sp.position, sp.normal, scene.light.position).org);
+            EXPECT_EQ(bounce.rays[k].org, sh.rays[k].org);
+            EXPECT_EQ(bounce.rays[k].tfar, kInfinity);
+            EXPECT_GE(dot(bounce.rays[k].dir, sp.normal), -1e-6f);
+            Hit expected;
+            accel->intersect(std::span(&bounce.rays[k], 1), std::span(&expected, 1));
+            EXPECT_EQ(bounce.hits[k], expected);
+            if (!expected.is_hit()) continue;
+            const SurfacePoint bp = surface_point(scene.triangles[expected.prim], bounce.rays[k], expected);
+            expected_bs.push_back(shadow_ray(bp.position, bp.normal, scene.light.position));
+            EXPECT_EQ(bs.parent[expected_bs.size() - 1], k);
+        }
+        EXPECT_TRUE(same_rays(bs.rays, expected_bs)) << p;
+        bounce_hits += expected_bs.size();
+    }
+    EXPECT_GT(bounce_hits, 0u);
+}
+
+// A pixel's AO and bounce rays are hashes of the pixel: the same in packets of any size.
+TEST(Workload, APixelsRaysDoNotDependOnThePacketSize) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    const PinholeCamera camera(scene.camera, kWidth, kHeight);
+    for (const Shading shading : {Shading::ao, Shading::diffuse}) {
+        const RayKind kind = secondary_kind(shading);
+        auto by_pixel = [&](int packet) {
+            std::map<int, std::vector<Ray>> out;
+            const PacketGrid grid(kWidth, kHeight, packet);
+            PacketWorkload work(scene, camera, static_cast<std::size_t>(packet * packet), shading_of(shading, 3));
+            for (std::size_t p = 0; p < grid.count(); ++p) {
+                const PixelRect rect = grid.rect(p);
+                work.trace(rect, *accel);
+                const RayBatch b = work.batch(kind);
+                for (std::size_t k = 0; k < b.rays.size(); ++k) {
+                    const int o = static_cast<int>(work.order()[b.parent[k]]);
+                    out[(rect.y0 + o / rect.width()) * kWidth + rect.x0 + o % rect.width()].push_back(b.rays[k]);
+                }
+            }
+            return out;
+        };
+        const auto reference = by_pixel(kPacket);
+        ASSERT_GT(reference.size(), 100u);
+        for (int packet : {1, 5, 16}) {
+            const auto other = by_pixel(packet);
+            ASSERT_EQ(other.size(), reference.size()) << to_string(shading) << " packet " << packet;
+            for (const auto& [pixel, rays] : reference)
+                EXPECT_TRUE(same_rays(other.at(pixel), rays)) << to_string(shading) << " pixel " << pixel;
+        }
+    }
+}
+
+TEST(Workload, RefusesAnUnknownShadingAndAoSamplesOutOfRange) {
+    EXPECT_EQ(parse_shading("ao"), Shading::ao);
+    EXPECT_THROW(parse_shading("phong"), Error);
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=200");
+    const PinholeCamera camera(scene.camera, 8, 8);
+    for (int n : {0, -1, kMaxAoSamples + 1})
+        EXPECT_THROW(PacketWorkload(scene, camera, 64, shading_of(Shading::ao, n)), Error) << n;
+}
+
+// The frame of the hemisphere: unit directions that never point below the surface, for normals along
+// the axes (both signs, where the frame's formula changes branch) and in between.
+TEST(Sampling, CosineHemisphereStaysAboveTheSurface) {
+    std::vector<Vec3> normals = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -0.f}};
+    for (int i = 0; i < 200; ++i)
+        normals.push_back(normalize(Vec3{hash_uniform(i, 0, 0) - 0.5f, hash_uniform(i, 0, 1) - 0.5f,
+                                         hash_uniform(i, 0, 2) - 0.5f}));
+    normals[6] = normalize(Vec3{1e-7f, 0.f, -1.f});
+    for (const Vec3& n : normals)
+        for (std::uint32_t s = 0; s < 64; ++s) {
+            const Vec3 d = cosine_hemisphere(n, hash_uniform(7, s, 0), hash_uniform(7, s, 1));
+            EXPECT_NEAR(length(d), 1.f, 1e-5f);
+            EXPECT_GE(dot(d, n), -1e-6f);
+        }
+    EXPECT_NE(hash_uniform(1, 0, 0), hash_uniform(2, 0, 0));
+    EXPECT_NE(hash_uniform(1, 0, 0), hash_uniform(1, 1, 0));
+    EXPECT_NE(hash_uniform(1, 0, 0), hash_uniform(1, 0, 1));
 }
 
 // Records every batch it is given, in order, and answers through another accelerator.
@@ -98,35 +248,49 @@ private:
     mutable std::mutex mutex_;
 };
 
-// One worker traces the packets in the grid's order, so its batches are the frame's packets one by one.
+// One worker traces the packets in the grid's order, so its batches are the frame's packets one by one:
+// for each shading, the recorded batch of the secondary kind is frame_rays()'s.
 TEST(Workload, TheRendererTracesTheRaysThatFrameRaysCollects) {
     const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
     const auto brute = make_accelerator(scene.triangles, AccelConfig{"brute"});
-    const RecordingAccelerator recording(*brute);
-    RenderOptions o;
-    o.width = kWidth;
-    o.height = kHeight;
-    o.packet = kPacket;
-    o.threads = 1;
-    RenderStats stats;
-    render(scene, recording, o, &stats);
-
-    const FrameRays f = frame_rays(scene, kWidth, kHeight, kPacket, *make_accelerator(scene.triangles, AccelConfig{"kd"}));
+    const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
     const PacketGrid grid(kWidth, kHeight, kPacket);
-    ASSERT_EQ(f.packets.size(), grid.count());
-    ASSERT_EQ(recording.intersected.size(), grid.count());
-    ASSERT_EQ(recording.occlusion_tested.size(), grid.count());
-    for (std::size_t p = 0; p < grid.count(); ++p) {
-        const FrameRays::Packet& packet = f.packets[p];
-        EXPECT_EQ(packet.index, p);
-        EXPECT_TRUE(same_rays(recording.intersected[p], std::span(f.primary).subspan(packet.primary, packet.primary_count)))
-            << "primary rays of packet " << p;
-        EXPECT_TRUE(same_rays(recording.occlusion_tested[p], std::span(f.shadow).subspan(packet.shadow, packet.shadow_count)))
-            << "shadow rays of packet " << p;
+    for (const Shading shading : {Shading::direct, Shading::ao, Shading::diffuse}) {
+        const RecordingAccelerator recording(*brute);
+        RenderOptions o;
+        o.width = kWidth;
+        o.height = kHeight;
+        o.packet = kPacket;
+        o.threads = 1;
+        o.shading = shading_of(shading, 3);
+        RenderStats stats;
+        render(scene, recording, o, &stats);
+
+        const FrameRays f = frame_rays(scene, kWidth, kHeight, kPacket, *kd, o.shading);
+        ASSERT_EQ(f.packets.size(), grid.count());
+        // Closest-hit batches per packet: primary (and bounce); any-hit: shadow or AO (and bounce shadow).
+        const bool diffuse = shading == Shading::diffuse;
+        ASSERT_EQ(recording.intersected.size(), grid.count() * (diffuse ? 2 : 1)) << to_string(shading);
+        std::size_t all = 0;
+        for (const auto& b : recording.intersected) all += b.size();
+        for (const auto& b : recording.occlusion_tested) all += b.size();
+        for (std::size_t p = 0; p < grid.count(); ++p) {
+            const FrameRays::Packet& packet = f.packets[p];
+            EXPECT_EQ(packet.index, p);
+            const std::size_t first = diffuse ? 2 * p : p;
+            EXPECT_TRUE(same_rays(recording.intersected[first], std::span(f.primary).subspan(packet.primary, packet.primary_count)))
+                << to_string(shading) << ": primary rays of packet " << p;
+            const auto secondary = std::span(f.secondary).subspan(packet.secondary, packet.secondary_count);
+            const std::vector<Ray>& traced = diffuse ? recording.intersected[first + 1] : recording.occlusion_tested[p];
+            EXPECT_TRUE(same_rays(traced, secondary)) << to_string(shading) << ": secondary rays of packet " << p;
+        }
+        EXPECT_EQ(f.primary.size(), stats.primary_rays);
+        EXPECT_EQ(f.frame_ray_count, stats.primary_rays + stats.secondary_rays) << to_string(shading);
+        EXPECT_EQ(all, f.frame_ray_count) << to_string(shading);
+        if (!diffuse) {
+            EXPECT_EQ(f.secondary.size(), stats.secondary_rays);
+        }
     }
-    EXPECT_EQ(f.primary.size(), stats.primary_rays);
-    EXPECT_EQ(f.shadow.size(), stats.shadow_rays);
-    EXPECT_EQ(f.frame_ray_count, stats.primary_rays + stats.shadow_rays);
 }
 
 // The cache study keeps a sample of the packets: each kept packet has the very rays it has in the
@@ -135,9 +299,9 @@ TEST(Workload, KeptPacketsHaveTheirRaysInTheWholeFrame) {
     const Scene scene = make_builtin_scene("builtin:spheres?tris=2000");
     const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
     const FrameRays all = frame_rays(scene, kWidth, kHeight, kPacket, *kd);
-    const FrameRays some = frame_rays(scene, kWidth, kHeight, kPacket, *kd, [](std::size_t p) { return p % 3 == 1; });
+    const FrameRays some = frame_rays(scene, kWidth, kHeight, kPacket, *kd, {}, [](std::size_t p) { return p % 3 == 1; });
     EXPECT_EQ(some.frame_ray_count, all.frame_ray_count);
-    EXPECT_EQ(all.frame_ray_count, all.primary.size() + all.shadow.size());
+    EXPECT_EQ(all.frame_ray_count, all.primary.size() + all.secondary.size());
     std::vector<std::size_t> kept;
     for (const FrameRays::Packet& k : some.packets) kept.push_back(k.index);
     EXPECT_EQ(kept, (std::vector<std::size_t>{1, 4, 7, 10, 13, 16, 19}));  // of the 5 x 4 packets
@@ -145,8 +309,8 @@ TEST(Workload, KeptPacketsHaveTheirRaysInTheWholeFrame) {
         const FrameRays::Packet& a = all.packets[k.index];
         EXPECT_TRUE(same_rays(std::span(some.primary).subspan(k.primary, k.primary_count),
                               std::span(all.primary).subspan(a.primary, a.primary_count)));
-        EXPECT_TRUE(same_rays(std::span(some.shadow).subspan(k.shadow, k.shadow_count),
-                              std::span(all.shadow).subspan(a.shadow, a.shadow_count)));
+        EXPECT_TRUE(same_rays(std::span(some.secondary).subspan(k.secondary, k.secondary_count),
+                              std::span(all.secondary).subspan(a.secondary, a.secondary_count)));
     }
 }
 

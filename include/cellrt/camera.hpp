@@ -22,6 +22,9 @@ public:
         return r;
     }
 
+    int width() const { return static_cast<int>(width_); }
+    int height() const { return static_cast<int>(height_); }
+
 private:
     Vec3 origin_, forward_, right_, up_;
     float half_w_ = 0.f, half_h_ = 0.f;

@@ -1,5 +1,7 @@
-// The study's renderer: one primary ray per pixel, and for every hit one shadow ray toward the point
-// light; diffuse shading with a little ambient light, a sky colour for misses.
+// The renderer: one primary ray per pixel and the rays its shading casts from the hits (workload.hpp).
+// `direct` is the study's: one shadow ray toward the point light, Lambert shading with a little ambient
+// light. `ao` shades by the fraction of AO rays that escape; `diffuse` adds to the direct light one
+// cosine-weighted bounce lit by the point light (or the sky where it escapes). Misses show the sky.
 #pragma once
 
 #include <atomic>
@@ -9,6 +11,7 @@
 #include "cellrt/image.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/schedule.hpp"
+#include "cellrt/workload.hpp"
 
 namespace cellrt {
 
@@ -17,6 +20,7 @@ struct RenderOptions {
     int height = 512;
     unsigned threads = 0;  // worker threads; 0: all hardware threads
     int packet = 16;       // packet edge P in pixels: a P x P packet is one batch for the accelerator
+    ShadingOptions shading;
     Dispatch dispatch = Dispatch::pull;  // how packets reach the workers (schedule.hpp)
     bool pin = false;      // pin worker threads to cores
     std::chrono::microseconds idle_spin = kDefaultIdleSpin;  // workers' poll before sleeping (schedule.hpp)
@@ -30,8 +34,8 @@ struct RenderOptions {
 struct RenderStats {
     double seconds = 0.0;
     std::uint64_t primary_rays = 0;
-    std::uint64_t shadow_rays = 0;
-    TraversalCounters primary, shadow;  // filled when RenderOptions::count
+    std::uint64_t secondary_rays = 0;      // every other ray: shadow, AO, bounce and bounce shadow rays
+    TraversalCounters primary, secondary;  // filled when RenderOptions::count
     std::vector<WorkerLoad> workers;    // what each worker traced, and for how long
 };
 

@@ -24,24 +24,61 @@ Vec3 sky(const Vec3& dir) {
 // lines of their own: workers update their counters on every packet.
 struct alignas(kCacheLine) PacketWork {
     PacketWorkload rays;
-    TraversalCounters primary, shadow;
-    std::uint64_t shadow_ray_count = 0;
+    TraversalCounters primary, secondary;
+    std::uint64_t secondary_ray_count = 0;
 };
 
-// The packet's rays (workload.hpp), then its shading: sky for a miss, diffuse light where the shadow
-// ray reaches the light, ambient light everywhere on a surface.
+// Lambert's cosine at the start of shadow ray k, 0 where something blocks the light.
+float lambert(const RayBatch& shadow, std::size_t k) {
+    return shadow.occluded[k] ? 0.f : std::max(0.f, dot(shadow.normals[k], shadow.rays[k].dir));
+}
+
+// The packet's shading from its rays (workload.hpp). Each pixel's colour is a sum in a fixed order
+// of terms that hits decide, so it is the same bits under every structure.
+void shade(const Scene& scene, const PacketWorkload& r, std::span<Vec3> colours) {
+    const auto order = r.order();
+    const RayBatch primary = r.batch(RayKind::primary);
+    for (std::size_t i = 0; i < primary.rays.size(); ++i)
+        if (!primary.hits[i].is_hit()) colours[order[i]] = sky(primary.rays[i].dir);
+    switch (r.shading().shading) {
+        case Shading::direct: {
+            const RayBatch shadow = r.batch(RayKind::shadow);
+            for (std::size_t k = 0; k < shadow.rays.size(); ++k)
+                colours[order[shadow.parent[k]]] = kAlbedo * (kAmbient + lambert(shadow, k)) * scene.light.color;
+            break;
+        }
+        case Shading::ao: {
+            // The AO rays of a hit are consecutive: count those that escape, then shade once.
+            const RayBatch ao = r.batch(RayKind::ao);
+            const auto n = static_cast<std::size_t>(r.shading().ao_samples);
+            for (std::size_t k = 0; k < ao.rays.size(); k += n) {
+                std::size_t open = 0;
+                for (std::size_t s = k; s < k + n; ++s) open += !ao.occluded[s];
+                colours[order[ao.parent[k]]] = kAlbedo * (static_cast<float>(open) / static_cast<float>(n));
+            }
+            break;
+        }
+        case Shading::diffuse: {
+            // With cosine-weighted bounces the estimate of the light a bounce brings is what arrives
+            // along it (the cosine and the density cancel): the sky, or the direct light at its hit.
+            const RayBatch shadow = r.batch(RayKind::shadow), bounce = r.batch(RayKind::bounce),
+                           bounce_shadow = r.batch(RayKind::bounce_shadow);
+            std::size_t m = 0;  // the next bounce shadow ray
+            for (std::size_t k = 0; k < shadow.rays.size(); ++k) {
+                Vec3 incoming = sky(bounce.rays[k].dir);
+                if (bounce.hits[k].is_hit()) incoming = kAlbedo * scene.light.color * lambert(bounce_shadow, m++);
+                colours[order[shadow.parent[k]]] = kAlbedo * (scene.light.color * lambert(shadow, k) + incoming);
+            }
+            break;
+        }
+    }
+}
+
 void trace_packet(const Scene& scene, const Accelerator& accel, const PixelRect& rect, bool count, PacketWork& w,
                   std::span<Vec3> colours) {
-    PacketWorkload& r = w.rays;
-    r.trace(rect, accel, count ? &w.primary : nullptr, count ? &w.shadow : nullptr);
-    w.shadow_ray_count += r.shadow().size();
-    const auto order = r.order();
-    for (std::size_t i = 0; i < r.primary().size(); ++i)
-        if (!r.hits()[i].is_hit()) colours[order[i]] = sky(r.primary()[i].dir);
-    for (std::size_t k = 0; k < r.shadow().size(); ++k) {
-        const float lambert = r.occluded()[k] ? 0.f : std::max(0.f, dot(r.normals()[k], r.shadow()[k].dir));
-        colours[order[r.shadow_primary()[k]]] = kAlbedo * (kAmbient + lambert) * scene.light.color;
-    }
+    w.rays.trace(rect, accel, count ? &w.primary : nullptr, count ? &w.secondary : nullptr);
+    w.secondary_ray_count += w.rays.ray_count() - w.rays.batch(RayKind::primary).rays.size();
+    shade(scene, w.rays, colours);
 }
 
 }  // namespace
@@ -99,7 +136,8 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     const auto packet_rays = static_cast<std::size_t>(options.packet) * static_cast<std::size_t>(options.packet);
     std::vector<PacketWork> work;
     work.reserve(worker_count(schedule));
-    for (unsigned w = 0; w < worker_count(schedule); ++w) work.push_back({PacketWorkload(scene, camera, packet_rays)});
+    for (unsigned w = 0; w < worker_count(schedule); ++w)
+        work.push_back({PacketWorkload(scene, camera, packet_rays, options.shading)});
 
     Timer timer;
     std::vector<WorkerLoad> loads;
@@ -117,8 +155,8 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
         stats->workers = std::move(loads);
         for (const PacketWork& w : work) {
             stats->primary += w.primary;
-            stats->shadow += w.shadow;
-            stats->shadow_rays += w.shadow_ray_count;
+            stats->secondary += w.secondary;
+            stats->secondary_rays += w.secondary_ray_count;
         }
     }
 }

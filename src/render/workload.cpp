@@ -1,9 +1,91 @@
 #include "cellrt/workload.hpp"
 
+#include <array>
+
 #include "cellrt/render.hpp"
+#include "cellrt/sampling.hpp"
+#include "kernel/named.hpp"
 #include "schedule/cache_line.hpp"
 
 namespace cellrt {
+namespace {
+
+constexpr detail::Named<Shading> kShadings[] = {
+    {"direct", Shading::direct}, {"ao", Shading::ao}, {"diffuse", Shading::diffuse}};
+constexpr detail::Named<RayKind> kRayKindNames[] = {{"primary", RayKind::primary},
+                                                    {"shadow", RayKind::shadow},
+                                                    {"ao", RayKind::ao},
+                                                    {"bounce", RayKind::bounce},
+                                                    {"bounce shadow", RayKind::bounce_shadow}};
+
+// The random numbers of a pixel: sample s of the AO rays uses dimensions 0 and 1, the bounce
+// dimensions 2 and 3, so no two rays of a pixel share a number.
+constexpr std::uint32_t kAoDims = 0, kBounceDims = 2;
+
+// A ray leaving the surface point `sp` in the cosine-weighted direction drawn for (pixel, sample,
+// dims), reaching `tfar`; its origin is pushed off the surface as a shadow ray's is.
+Ray hemisphere_ray(const SurfacePoint& sp, std::uint64_t pixel, std::uint32_t sample, std::uint32_t dims, float tfar) {
+    Ray r;
+    r.org = offset_ray_origin(sp.position, sp.normal);
+    r.dir = cosine_hemisphere(sp.normal, hash_uniform(pixel, sample, dims), hash_uniform(pixel, sample, dims + 1));
+    r.tfar = tfar;
+    return r;
+}
+
+}  // namespace
+
+Shading parse_shading(const std::string& name) { return detail::value_named(kShadings, name, "shading"); }
+const char* to_string(Shading s) { return detail::name_of(kShadings, s); }
+std::vector<std::string> shading_names() { return detail::names_of(kShadings); }
+const char* to_string(RayKind k) { return detail::name_of(kRayKindNames, k); }
+
+RayKind secondary_kind(Shading s) {
+    switch (s) {
+        case Shading::ao: return RayKind::ao;
+        case Shading::diffuse: return RayKind::bounce;
+        case Shading::direct: break;
+    }
+    return RayKind::shadow;
+}
+
+// One kind's rays of a packet, what they were cast from and the accelerator's answers.
+struct RayBuffers {
+    CacheLineVector<Ray> rays;
+    CacheLineVector<std::uint32_t> parent;
+    CacheLineVector<Vec3> normals;
+    CacheLineVector<Hit> hits;
+    CacheLineVector<std::uint8_t> occluded;
+
+    void reserve(std::size_t n) {
+        rays.reserve(n);
+        parent.reserve(n);
+        normals.reserve(n);
+        hits.reserve(n);
+        occluded.reserve(n);
+    }
+    void clear() {
+        rays.clear();
+        parent.clear();
+        normals.clear();
+        hits.clear();
+        occluded.clear();
+    }
+    void add(const Ray& r, std::size_t from, const Vec3& normal) {
+        rays.push_back(r);
+        parent.push_back(static_cast<std::uint32_t>(from));
+        normals.push_back(normal);
+    }
+    void trace(const Accelerator& accel, RayKind kind, TraversalCounters* counters) {
+        if (closest_hit(kind)) {
+            hits.resize(rays.size());
+            accel.intersect(rays, hits, counters);
+        } else {
+            occluded.resize(rays.size());
+            accel.occluded(rays, occluded, counters);
+        }
+    }
+    RayBatch view() const { return {rays, parent, normals, hits, occluded}; }
+};
 
 // Kept on lines of their own: per-worker buffers are allocated one after another on one thread, and
 // a line shared by two workers' buffers would pass between their cores on every packet
@@ -11,23 +93,31 @@ namespace cellrt {
 struct alignas(kCacheLine) PacketWorkload::Buffers {
     CacheLineVector<std::uint32_t> order;
     int order_width = 0, order_height = 0;  // the packet shape `order` was made for
-    CacheLineVector<Ray> primary, shadow;
-    CacheLineVector<Hit> hits;
-    CacheLineVector<std::uint32_t> shadow_primary;
-    CacheLineVector<Vec3> normals;
-    CacheLineVector<std::uint8_t> occluded;
+    CacheLineVector<std::uint64_t> pixel;   // primary ray i's pixel index in the frame
+    std::array<RayBuffers, kRayKinds> kinds;
+
+    RayBuffers& operator[](RayKind k) { return kinds[static_cast<std::size_t>(k)]; }
+    const RayBuffers& operator[](RayKind k) const { return kinds[static_cast<std::size_t>(k)]; }
 };
 
-PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels)
-    : scene_(&scene), camera_(&camera), buffers_(std::make_unique<Buffers>()) {
+PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
+                               const ShadingOptions& shading)
+    : scene_(&scene), camera_(&camera), shading_(shading), buffers_(std::make_unique<Buffers>()) {
+    if (shading.ao_samples < 1 || shading.ao_samples > kMaxAoSamples)
+        throw Error("AO samples " + std::to_string(shading.ao_samples) + " must lie in [1, " +
+                    std::to_string(kMaxAoSamples) + "]");
+    ao_reach_ = kAoReachFraction * length(scene.bounds().extent());
     Buffers& b = *buffers_;
     b.order.reserve(max_pixels);
-    b.primary.reserve(max_pixels);
-    b.shadow.reserve(max_pixels);
-    b.hits.reserve(max_pixels);
-    b.shadow_primary.reserve(max_pixels);
-    b.normals.reserve(max_pixels);
-    b.occluded.reserve(max_pixels);
+    b.pixel.reserve(max_pixels);
+    b[RayKind::primary].reserve(max_pixels);
+    switch (shading.shading) {
+        case Shading::direct: b[RayKind::shadow].reserve(max_pixels); break;
+        case Shading::ao: b[RayKind::ao].reserve(max_pixels * static_cast<std::size_t>(shading.ao_samples)); break;
+        case Shading::diffuse:
+            for (RayKind k : {RayKind::shadow, RayKind::bounce, RayKind::bounce_shadow}) b[k].reserve(max_pixels);
+            break;
+    }
 }
 
 PacketWorkload::PacketWorkload(PacketWorkload&&) noexcept = default;
@@ -35,7 +125,7 @@ PacketWorkload& PacketWorkload::operator=(PacketWorkload&&) noexcept = default;
 PacketWorkload::~PacketWorkload() = default;
 
 void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, TraversalCounters* primary,
-                           TraversalCounters* shadow) {
+                           TraversalCounters* secondary) {
     Buffers& b = *buffers_;
     if (rect.width() != b.order_width || rect.height() != b.order_height) {  // only edge packets differ
         b.order.resize(static_cast<std::size_t>(rect.pixels()));
@@ -43,49 +133,81 @@ void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, Trav
         b.order_width = rect.width();
         b.order_height = rect.height();
     }
-    b.primary.clear();
-    for (const std::uint32_t p : b.order)
-        b.primary.push_back(camera_->primary(rect.x0 + static_cast<int>(p) % rect.width(),
-                                             rect.y0 + static_cast<int>(p) / rect.width()));
-    b.hits.resize(b.primary.size());
-    accel.intersect(b.primary, b.hits, primary);
-
-    b.shadow.clear();
-    b.shadow_primary.clear();
-    b.normals.clear();
-    for (std::size_t i = 0; i < b.primary.size(); ++i) {
-        const Hit& h = b.hits[i];
-        if (!h.is_hit()) continue;
-        const SurfacePoint sp = surface_point(scene_->triangles[h.prim], b.primary[i], h);
-        b.shadow.push_back(shadow_ray(sp.position, sp.normal, scene_->light.position));
-        b.shadow_primary.push_back(static_cast<std::uint32_t>(i));
-        b.normals.push_back(sp.normal);
+    for (RayBuffers& k : b.kinds) k.clear();
+    b.pixel.clear();
+    RayBuffers& prim = b[RayKind::primary];
+    for (const std::uint32_t p : b.order) {
+        const int x = rect.x0 + static_cast<int>(p) % rect.width(), y = rect.y0 + static_cast<int>(p) / rect.width();
+        prim.rays.push_back(camera_->primary(x, y));
+        b.pixel.push_back(static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(camera_->width()) +
+                          static_cast<std::uint64_t>(x));
     }
-    b.occluded.resize(b.shadow.size());
-    accel.occluded(b.shadow, b.occluded, shadow);
+    prim.trace(accel, RayKind::primary, primary);
+
+    const Vec3 light = scene_->light.position;
+    for (std::size_t i = 0; i < prim.rays.size(); ++i) {
+        const Hit& h = prim.hits[i];
+        if (!h.is_hit()) continue;
+        const SurfacePoint sp = surface_point(scene_->triangles[h.prim], prim.rays[i], h);
+        switch (shading_.shading) {
+            case Shading::direct: b[RayKind::shadow].add(shadow_ray(sp.position, sp.normal, light), i, sp.normal); break;
+            case Shading::ao:
+                for (int s = 0; s < shading_.ao_samples; ++s)
+                    b[RayKind::ao].add(hemisphere_ray(sp, b.pixel[i], static_cast<std::uint32_t>(s), kAoDims, ao_reach_),
+                                       i, sp.normal);
+                break;
+            case Shading::diffuse:
+                b[RayKind::shadow].add(shadow_ray(sp.position, sp.normal, light), i, sp.normal);
+                b[RayKind::bounce].add(hemisphere_ray(sp, b.pixel[i], 0, kBounceDims, kInfinity), i, sp.normal);
+                break;
+        }
+    }
+    // Every batch the shading casts is traced, empty or not: an accelerator sees the same calls for
+    // every packet.
+    if (shading_.shading == Shading::ao) {
+        b[RayKind::ao].trace(accel, RayKind::ao, secondary);
+        return;
+    }
+    b[RayKind::shadow].trace(accel, RayKind::shadow, secondary);
+    if (shading_.shading == Shading::direct) return;
+
+    RayBuffers& bounce = b[RayKind::bounce];
+    bounce.trace(accel, RayKind::bounce, secondary);
+    RayBuffers& bounce_shadow = b[RayKind::bounce_shadow];
+    for (std::size_t j = 0; j < bounce.rays.size(); ++j) {
+        const Hit& h = bounce.hits[j];
+        if (!h.is_hit()) continue;
+        const SurfacePoint sp = surface_point(scene_->triangles[h.prim], bounce.rays[j], h);
+        bounce_shadow.add(shadow_ray(sp.position, sp.normal, light), j, sp.normal);
+    }
+    bounce_shadow.trace(accel, RayKind::bounce_shadow, secondary);
 }
 
 std::span<const std::uint32_t> PacketWorkload::order() const { return buffers_->order; }
-std::span<const Ray> PacketWorkload::primary() const { return buffers_->primary; }
-std::span<const Hit> PacketWorkload::hits() const { return buffers_->hits; }
-std::span<const Ray> PacketWorkload::shadow() const { return buffers_->shadow; }
-std::span<const std::uint32_t> PacketWorkload::shadow_primary() const { return buffers_->shadow_primary; }
-std::span<const Vec3> PacketWorkload::normals() const { return buffers_->normals; }
-std::span<const std::uint8_t> PacketWorkload::occluded() const { return buffers_->occluded; }
+RayBatch PacketWorkload::batch(RayKind k) const { return (*buffers_)[k].view(); }
+
+std::size_t PacketWorkload::ray_count() const {
+    std::size_t n = 0;
+    for (const RayBuffers& k : buffers_->kinds) n += k.rays.size();
+    return n;
+}
 
 FrameRays frame_rays(const Scene& scene, int width, int height, int packet, const Accelerator& accel,
-                     const std::function<bool(std::size_t)>& keep) {
+                     const ShadingOptions& shading, const std::function<bool(std::size_t)>& keep) {
     const PacketGrid grid(width, height, packet);
     const PinholeCamera camera(scene.camera, width, height);
-    PacketWorkload work(scene, camera, static_cast<std::size_t>(packet) * static_cast<std::size_t>(packet));
+    PacketWorkload work(scene, camera, static_cast<std::size_t>(packet) * static_cast<std::size_t>(packet), shading);
     FrameRays f;
+    f.secondary_kind = secondary_kind(shading.shading);
     for (std::size_t p = 0; p < grid.count(); ++p) {
         work.trace(grid.rect(p), accel);
-        f.frame_ray_count += work.primary().size() + work.shadow().size();
+        f.frame_ray_count += work.ray_count();
         if (keep && !keep(p)) continue;
-        f.packets.push_back({p, f.primary.size(), work.primary().size(), f.shadow.size(), work.shadow().size()});
-        f.primary.insert(f.primary.end(), work.primary().begin(), work.primary().end());
-        f.shadow.insert(f.shadow.end(), work.shadow().begin(), work.shadow().end());
+        const std::span<const Ray> primary = work.batch(RayKind::primary).rays;
+        const std::span<const Ray> secondary = work.batch(f.secondary_kind).rays;
+        f.packets.push_back({p, f.primary.size(), primary.size(), f.secondary.size(), secondary.size()});
+        f.primary.insert(f.primary.end(), primary.begin(), primary.end());
+        f.secondary.insert(f.secondary.end(), secondary.begin(), secondary.end());
     }
     return f;
 }
