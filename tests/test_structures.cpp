@@ -18,9 +18,10 @@ namespace {
 // each instruction set this machine runs; and the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
-                                    "bih:branched@split=sah", "bih+auto@split=sah"};
+                                    "bih:branched@split=sah", "bih+auto@split=sah", "bvh+portable"};
     for (detail::Isa isa : detail::available_isas())
         for (const char* kind : {"kd", "bih"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
+    if (detail::available_isas().back() != detail::Isa::portable) out.push_back("bvh+auto");
     return out;
 }
 const std::vector<std::string> kConfigs = exact_configs();

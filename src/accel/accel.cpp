@@ -1,5 +1,5 @@
 // The registry: every structure this binary offers, by kind. The trees come from the one list
-// (structures.hpp); brute force and Embree are backends of their own.
+// (structures.hpp); brute force, the wide BVH and Embree are backends of their own.
 #include "cellrt/accel.hpp"
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include "accel/structures.hpp"
 #include "accel/tree_accelerator.hpp"
 #include "accel/brute_force_listing.hpp"
+#include "bvh/bvh_accel.hpp"
 #include "cellrt/brute_force.hpp"
 #include "cellrt/error.hpp"
 #include "kernel/named.hpp"
@@ -42,6 +43,7 @@ std::vector<Entry> make_entries() {
                            },
                            &S::param_table(), detail::names_of(S::kTraversals), &detail::make_model<S>});
     });
+    entries.push_back({"bvh", &make_bvh, &bvh_params(), bvh_traversals()});
 #ifdef CELLRT_HAVE_EMBREE
     entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
 #endif

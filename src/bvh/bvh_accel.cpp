@@ -1,0 +1,102 @@
+#include "bvh/bvh_accel.hpp"
+
+#include "bvh/bvh_isa.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/timer.hpp"
+#include "kernel/param_reader.hpp"
+#include "simd/isa.hpp"
+
+namespace cellrt {
+namespace {
+
+const std::vector<std::string> kTraversals{"wide"};
+
+// The kernels for `simd` (see bvh_accel.hpp), with the name of their instruction set.
+std::pair<const detail::BvhKernels*, const char*> kernels_for(const std::string& simd) {
+    if (simd == "avx512") throw Error("the BVH's nodes are eight wide: its kernels run portable or avx2, not avx512");
+    const detail::Isa isa = detail::parse_isa(simd == "off" ? "auto" : simd);
+    if (isa == detail::Isa::avx2 || isa == detail::Isa::avx512) return {&detail::bvh_kernels_avx2(), "avx2"};
+    return {&detail::bvh_kernels_portable(), "portable"};
+}
+
+class BvhAccelerator final : public Accelerator {
+public:
+    BvhAccelerator(std::span<const Triangle> triangles, const detail::BvhBuildOptions& options,
+                   const detail::BvhKernels& kernels, const char* isa)
+        : options_(options), kernels_(kernels), isa_(isa), triangle_count_(triangles.size()) {
+        const Timer timer;
+        tree_ = detail::build_bvh(triangles, options);
+        build_seconds_ = timer.seconds();
+    }
+
+    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        kernels_.closest(tree_, rays, hits, counters);
+    }
+    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                  TraversalCounters* counters) const override {
+        kernels_.any(tree_, rays, occluded, counters);
+    }
+
+    AccelStats stats() const override {
+        AccelStats s;
+        s.name = "bvh";
+        s.traversal = "wide";
+        s.build_seconds = build_seconds_;
+        s.memory_bytes = tree_.nodes.size() * sizeof(detail::BvhNode) + tree_.leaves.size() * sizeof(detail::BvhLeaf);
+        s.triangles = triangle_count_;
+        TreeReport r;
+        r.nodes = tree_.nodes.size() + tree_.leaves.size();
+        r.inner_nodes = tree_.nodes.size();
+        r.leaves = tree_.leaves.size();
+        r.max_depth = tree_.depth;
+        r.triangles_per_leaf = tree_.mean_leaf_triangles;
+        r.references_per_triangle = triangle_count_ ? 1.0 : 0.0;
+        r.sah_cost = tree_.sah_cost;
+        s.tree = r;
+        s.settings = {{"bins", std::to_string(options_.bins)},
+                      {"max_leaf", std::to_string(options_.max_leaf)},
+                      {"traversal_cost", param_number(options_.traversal_cost)},
+                      {"intersection_cost", param_number(options_.intersection_cost)},
+                      {"isa", isa_}};
+        return s;
+    }
+
+private:
+    detail::BvhBuildOptions options_;
+    const detail::BvhKernels& kernels_;
+    const char* isa_;
+    std::size_t triangle_count_;
+    detail::BvhTree tree_;
+    double build_seconds_ = 0.0;
+};
+
+}  // namespace
+
+const ParamTable& bvh_params() {
+    using enum ParamType;
+    static const ParamTable table{
+        {"bins", integer, "16", 2, 256, {}, "centroid bins per axis of the binned SAH (Wald 2007)"},
+        {"max_leaf", integer, "8", 1, 8, {}, "most triangles in a leaf; a leaf is one eight-lane group"},
+        {"traversal_cost", number, "1", 0.001, 1000, {}, "SAH cost of visiting a node (eight box tests)"},
+        {"intersection_cost", number, "2", 0.001, 1000, {},
+         "SAH cost of testing a leaf (up to eight triangles at once)"},
+    };
+    return table;
+}
+
+const std::vector<std::string>& bvh_traversals() { return kTraversals; }
+
+std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config) {
+    detail::ParamReader params(bvh_params(), config, "bvh");
+    detail::BvhBuildOptions options;
+    options.bins = params.integer("bins");
+    options.max_leaf = params.integer("max_leaf");
+    options.traversal_cost = params.number("traversal_cost");
+    options.intersection_cost = params.number("intersection_cost");
+    params.finish();
+    detail::choose_traversal(kTraversals, config.traversal, "bvh");
+    const auto [kernels, isa] = kernels_for(config.simd);
+    return std::make_unique<BvhAccelerator>(triangles, options, *kernels, isa);
+}
+
+}  // namespace cellrt

@@ -1,0 +1,37 @@
+// The wide BVH's builder: a binary BVH by the surface area heuristic over binned centroids (Wald,
+// "On fast Construction of SAH-based Bounding Volume Hierarchies", RT 2007), collapsed into nodes of
+// eight children by pulling up the largest child until a node is full (Wald, Benthin, Boulos 2008,
+// section 3). Each triangle lies in exactly one leaf, and every box is the exact bounds of what lies
+// below it, so a conservative box test (kernel/traversal.hpp's margin) never misses a hit.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "bvh/bvh_node.hpp"
+#include "cellrt/box.hpp"
+#include "cellrt/triangle.hpp"
+
+namespace cellrt::detail {
+
+struct BvhBuildOptions {
+    int bins = 16;                   // centroid bins per axis
+    int max_leaf = 8;                // triangles per leaf, 1..8 (a leaf is one 8-lane group)
+    double traversal_cost = 1.0;     // of visiting a node (eight box tests)
+    double intersection_cost = 2.0;  // of testing a leaf (up to eight triangles at once)
+};
+
+struct BvhTree {
+    std::vector<BvhNode> nodes;  // the root is node 0; empty for a scene without triangles
+    std::vector<BvhLeaf> leaves;
+    Box3 bounds;
+    int depth = 0;               // of the deepest wide node, the root's being 0
+    std::size_t binary_nodes = 0;
+    double sah_cost = 0.0;       // of the binary tree, in the options' cost units
+    double mean_leaf_triangles = 0.0;
+};
+
+BvhTree build_bvh(std::span<const Triangle> triangles, const BvhBuildOptions& options);
+
+}  // namespace cellrt::detail

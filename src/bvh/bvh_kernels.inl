@@ -1,0 +1,182 @@
+// The wide BVH's single-ray kernels, included by each instruction set's translation unit
+// (bvh_<isa>.cpp) inside its target region and namespace, after simd/lanes.inl with kLanes = 8: one
+// lane per child of a node and per triangle of a leaf.
+//
+// A node: the ray's slab distances to the eight child boxes, widened by the ray's margin
+// (kernel/traversal.hpp) exactly as the scalar clip() widens the scene box, so that a box is missed
+// only when the ray passes it by more than the margin; the children met are visited nearest first,
+// the others pushed with their entry distance and skipped when popped past the query's cull distance.
+// A leaf: the watertight test (triangle.hpp) of its triangles, lane by lane in the scalar test's
+// operations and order, so each lane's t, u and v are the scalar test's bits; the hit rule then picks
+// among the lanes. Hence the kernels return exactly the hits of brute force.
+//
+// No include guard: every instruction set includes it once, in its own namespace and target.
+
+inline F load(const float* p) {
+    F x;
+    std::memcpy(&x, p, sizeof x);
+    return x;
+}
+
+inline U load_u(const std::uint32_t* p) {
+    U x;
+    std::memcpy(&x, p, sizeof x);
+    return x;
+}
+
+// The ray as the box tests of every node see it: its origin, reciprocal direction and margin in all
+// lanes, and for each axis the offset (in floats, from the node's lo[0]) of the planes it enters and
+// leaves a box by, chosen once by the direction's sign.
+struct BoxRay {
+    F org[3], inv[3], margin, tnear;
+    int enter[3], leave[3];
+
+    explicit BoxRay(const TraversalRay& r) : margin(splat(r.margin)), tnear(splat(r.tnear - r.margin)) {
+        for (int a = 0; a < 3; ++a) {
+            org[a] = splat(r.org[a]);
+            inv[a] = splat(r.inv_dir[a]);
+            const int lo = a * kBvhWidth, hi = (3 + a) * kBvhWidth;
+            enter[a] = r.dir_neg[a] ? hi : lo;
+            leave[a] = r.dir_neg[a] ? lo : hi;
+        }
+    }
+};
+
+// A node's children met by the ray within [tnear - margin, cull], as a bit mask, with each one's
+// entry distance.
+inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
+    static_assert(offsetof(BvhNode, hi) == 3 * kBvhWidth * sizeof(float), "hi follows lo");
+    const float* planes = &node.lo[0][0];
+    F enter = r.tnear, leave = splat(cull);
+    for (int a = 0; a < 3; ++a) {
+        const F t0 = (load(planes + r.enter[a]) - r.org[a]) * r.inv[a];
+        const F t1 = (load(planes + r.leave[a]) - r.org[a]) * r.inv[a];
+        enter = max_keep(enter, t0 - r.margin);
+        leave = min_keep(leave, t1 + r.margin);
+    }
+    entry = enter;
+    return bits(enter <= leave);
+}
+
+// The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
+// triangle, with t, u, v.
+inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const WatertightRay& r, F& t, F& u, F& v) {
+    const F ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
+    const F sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
+    const F a_kz = load(leaf.v[0][r.kz]) - oz, b_kz = load(leaf.v[1][r.kz]) - oz, c_kz = load(leaf.v[2][r.kz]) - oz;
+    const F ax = (load(leaf.v[0][r.kx]) - ox) - sx * a_kz, ay = (load(leaf.v[0][r.ky]) - oy) - sy * a_kz;
+    const F bx = (load(leaf.v[1][r.kx]) - ox) - sx * b_kz, by = (load(leaf.v[1][r.ky]) - oy) - sy * b_kz;
+    const F cx = (load(leaf.v[2][r.kx]) - ox) - sx * c_kz, cy = (load(leaf.v[2][r.ky]) - oy) - sy * c_kz;
+    F eu = cx * by - cy * bx;
+    F ev = ax * cy - ay * cx;
+    F ew = bx * ay - by * ax;
+    const I used = splat_i(static_cast<std::int32_t>(count)) > I{0, 1, 2, 3, 4, 5, 6, 7};
+    const I zero = used & ((eu == 0.f) | (ev == 0.f) | (ew == 0.f));
+    if (any(zero)) {
+        for (int i = 0; i < kLanes; ++i) {
+            if (zero[i] == 0) continue;
+            eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
+            ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
+            ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
+        }
+    }
+    const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
+    const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
+    const F det = eu + ev + ew;
+    const F az = sz * a_kz, bz = sz * b_kz, cz = sz * c_kz;
+    const F big_t = eu * az + ev * bz + ew * cz;
+    const F inv_det = splat(1.f) / det;
+    t = big_t * inv_det;
+    u = ev * inv_det;
+    v = ew * inv_det;
+    return used & ~(negative & positive) & (det != 0.f);
+}
+
+// Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
+// True when an any-hit query is answered.
+template <class Query, class Counters>
+bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, Query& q, Counters& c) {
+    c.leaf();
+    for (std::uint32_t i = 0; i < count; ++i) c.triangle();
+    F t, u, v;
+    const I hit = watertight_leaf(leaf, count, r.watertight, t, u, v);
+    if constexpr (Query::kAnyHit) {
+        return any(hit & (t >= splat(q.tnear)) & (t <= splat(q.tfar)));
+    } else {
+        unsigned b = bits(hit & (t >= splat(q.tnear)) & (t <= splat(q.best.t)));
+        for (; b; b &= b - 1) {
+            const int i = __builtin_ctz(b);
+            if (closer(t[i], leaf.prim[i], q.best)) q.best = Hit{t[i], leaf.prim[i], u[i], v[i]};
+        }
+        return false;
+    }
+}
+
+// A child waiting on the stack: its word and the distance at which the ray enters its box.
+struct BvhStackEntry {
+    std::uint32_t word;
+    float entry;
+};
+
+// Deep enough for any tree the builder makes: each level pushes at most seven children, and the
+// binary tree is at most kSahDepth + log2(2^32) levels deep, the wide one no deeper.
+inline constexpr int kBvhStackSize = 7 * 96 + 1;
+
+template <class Query, class Counters>
+bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+    const BoxRay box_ray(r);
+    BvhStackEntry stack[kBvhStackSize];
+    int sp = 0;
+    std::uint32_t word = 0;  // the root, an inner node
+    for (;;) {
+        if (BvhNode::is_leaf(word)) {
+            if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), r, q, c)) return true;
+        } else {
+            c.node();
+            const BvhNode& node = nodes[word];
+            F entry;
+            unsigned met = meet_children(node, box_ray, q.cull_t(), entry);
+            if (met) {
+                // Push the children met, farthest first, and go on with the nearest.
+                const int first = sp;
+                for (; met; met &= met - 1) {
+                    const int k = __builtin_ctz(met);
+                    const BvhStackEntry e{node.child[k], entry[k]};
+                    int j = sp++;
+                    for (; j > first && stack[j - 1].entry < e.entry; --j) stack[j] = stack[j - 1];
+                    stack[j] = e;
+                }
+                word = stack[--sp].word;
+                continue;
+            }
+        }
+        do {
+            if (sp == 0) return false;
+            --sp;
+        } while (stack[sp].entry > q.cull_t());
+        word = stack[sp].word;
+    }
+}
+
+// The batch entry points: one kernel per query, over a batch.
+inline void closest_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
+                          TraversalCounters* counters) {
+    closest_hits(tree.bounds, rays, hits, counters, [&](const TraversalRay& r, ClosestHit& q, auto& count) {
+        float tmin, tmax;
+        if (r.clip(tree.bounds, tmin, tmax)) traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
+        return false;
+    });
+}
+
+inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                      TraversalCounters* counters) {
+    any_hits(tree.bounds, rays, occluded, counters, [&](const TraversalRay& r, AnyHit& q, auto& count) {
+        float tmin, tmax;
+        return r.clip(tree.bounds, tmin, tmax) && traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
+    });
+}
+
+inline const BvhKernels& kernels() {
+    static const BvhKernels k{&closest_batch, &any_batch};
+    return k;
+}
