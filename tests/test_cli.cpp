@@ -137,6 +137,8 @@ TEST(Cli, NamesTheOptionAtFault) {
              {{"render", "--simd", "avx9", "-o", out},
               "--simd: SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
              {{"render", "-o", existing}, existing + ": file exists (pass --overwrite to replace it)"},
+             {{"info", "builtin:spheres?tris=100", "--accel", "kd", "--simd", "avx9"},
+              "--simd: SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
          }) {
         std::vector<std::string> all{CELLRT_CLI};
         all.insert(all.end(), args.begin(), args.end());
