@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 
@@ -42,6 +43,20 @@ AccelConfig AccelOptions::config() const {
         c.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
     return c;
+}
+
+std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config) {
+    try {
+        return make_accelerator(triangles, config);
+    } catch (const Error&) {
+        if (config.simd == "off") throw;
+        try {
+            detail::parse_isa(config.simd);
+        } catch (const Error& e) {
+            throw Error(std::string("--simd: ") + e.what());
+        }
+        throw;
+    }
 }
 
 void print_stats(const AccelStats& s) {

@@ -7,7 +7,9 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,6 +46,12 @@ struct AccelOptions {
     void add_to(CLI::App& cmd, bool kind_optional);
     AccelConfig config() const;
 };
+
+// The structure for `config`, as make_accelerator builds it. Where it is refused and the library
+// refuses the SIMD set too, the error is the --simd option's: the library speaks of the set, the user
+// typed the option (looked at only after a refusal: Embree ignores the set, and a bad one is no error
+// for it).
+std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config);
 
 void print_stats(const AccelStats& s);
 

@@ -54,7 +54,7 @@ Runner add_info(CLI::App& app) {
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         print_scene(scene, load_timer.seconds());
-        if (!o->accel.kind.empty()) print_stats(make_accelerator(scene.triangles, o->accel.config())->stats());
+        if (!o->accel.kind.empty()) print_stats(build_structure(scene.triangles, o->accel.config())->stats());
         return 0;
     };
 }

@@ -131,9 +131,11 @@ int run_child(const ProfileOptions& o) {
     return 0;
 }
 
-int run_profile(const ProfileOptions& o) {
-    bool hardware = o.method == "hardware";
-    if (o.method == "auto") {
+// Whether the counts come from the processor's counters (else from callgrind's simulation), refusing
+// at the start a method that cannot run here.
+bool use_hardware_counters(const std::string& method) {
+    bool hardware = method == "hardware";
+    if (method == "auto") {
         std::string why;
         hardware = profile::HardwareCounters::open(profile::HardwareCounters::Threads::calling_and_new, why)
                        .has_value();
@@ -144,20 +146,26 @@ int run_profile(const ProfileOptions& o) {
     if (!hardware && profile::find_valgrind().empty())
         throw Error("valgrind, which counts without hardware counters, is not on PATH (install the valgrind "
                     "package, see packages.txt)");
-    if (!o.json.empty() && !o.overwrite && std::filesystem::exists(o.json))
-        throw Error(o.json + ": file exists (pass --overwrite to replace it)");
+    return hardware;
+}
 
-    AccelConfig config = o.accel.config();
-    if (!hardware) {
-        std::string note;
-        try {
-            config = profile::config_for_callgrind(config, note);
-        } catch (const Error& e) {
-            throw Error(std::string("--simd: ") + e.what());
-        }
-        if (!note.empty()) std::printf("%s\n", note.c_str());
+// The structure's configuration as profiled: under callgrind, with a SIMD set valgrind can run.
+AccelConfig profiled_config(const AccelOptions& accel, bool hardware) {
+    AccelConfig config = accel.config();
+    if (hardware) return config;
+    std::string note;
+    try {
+        config = profile::config_for_callgrind(config, note);
+    } catch (const Error& e) {
+        throw Error(std::string("--simd: ") + e.what());
     }
-    const Scene scene = load_scene(o.scene);
+    if (!note.empty()) std::printf("%s\n", note.c_str());
+    return config;
+}
+
+// One render thread, at the view file's size with the counters and kCallgrindEdge under callgrind,
+// unless --size says otherwise.
+RenderOptions profiled_frame(const Scene& scene, const ProfileOptions& o, bool hardware) {
     RenderOptions ro;
     ro.width = ro.height = kCallgrindEdge;
     if (hardware) ro.width = scene.width, ro.height = scene.height;
@@ -165,8 +173,11 @@ int run_profile(const ProfileOptions& o) {
     ro.threads = 1;
     ro.packet = o.packet;
     ro.cancel = &g_cancel;
-    const auto accel = make_accelerator(scene.triangles, config);
-    const AccelStats st = accel->stats();
+    return ro;
+}
+
+void print_setup(const Scene& scene, const AccelStats& st, const AccelConfig& config, const RenderOptions& ro,
+                 bool hardware, bool default_size) {
     std::printf("profile                %s: %zu triangles, %s (%s%s), %dx%d, packet %d, 1 render thread\n",
                 scene.name.c_str(), scene.triangles.size(), st.name.c_str(), st.traversal.c_str(),
                 st.simd_lanes ? (", " + config.simd + ", " + std::to_string(st.simd_lanes) + " lanes").c_str() : "",
@@ -176,67 +187,110 @@ int run_profile(const ProfileOptions& o) {
     else
         std::printf("counts                 callgrind --branch-sim=yes: exact instructions, simulated predictor, no "
                     "cycles%s\n",
-                    o.size.empty() ? "; 128x128 is the default size under callgrind" : "");
+                    default_size ? "; 128x128 is the default size under callgrind" : "");
     std::fflush(stdout);
+}
 
-    // Native renders: the time (CPU time of the process, which a busy machine's other work does not
-    // inflate as it does wall time; best of kTimedRenders), then the kernels' work counters (which
-    // change the kernels' code, so they are never on while instructions are counted).
-    double native_seconds = 0.0;
+// The native render's time: CPU time of the process, which a busy machine's other work does not
+// inflate as it does wall time; best of kTimedRenders.
+double native_render_seconds(const Scene& scene, const Accelerator& accel, const RenderOptions& ro) {
+    double best = 0.0;
     for (int i = 0; i < kTimedRenders; ++i) {
         const double start = process_cpu_seconds();
-        render(scene, *accel, ro);
+        render(scene, accel, ro);
         const double seconds = process_cpu_seconds() - start;
-        native_seconds = i == 0 ? seconds : std::min(native_seconds, seconds);
+        best = i == 0 ? seconds : std::min(best, seconds);
     }
+    return best;
+}
+
+// A native render with the kernels' work counters on: they change the kernels' code, so they are
+// never on while instructions are counted.
+RenderStats counted_work(const Scene& scene, const Accelerator& accel, const RenderOptions& ro) {
     RenderStats work;
     RenderOptions counted = ro;
     counted.count = true;
-    render(scene, *accel, counted, &work);
-    TraversalCounters all = work.primary;
-    all += work.secondary;
+    render(scene, accel, counted, &work);
+    return work;
+}
 
+// The events of the whole render and of the traversal alone: from the counters in this process, or
+// from callgrind running this program again once per region.
+profile::RegionCounts event_counts(const Scene& scene, const Accelerator& accel, const RenderOptions& ro,
+                                   const std::string& scene_spec, const AccelConfig& config, bool hardware) {
+    if (hardware) return profile::measure_with_counters(scene, accel, ro);
     profile::RegionCounts counts;
-    if (hardware) {
-        counts = profile::measure_with_counters(scene, *accel, ro);
-    } else {
-        for (const profile::Region r : {profile::Region::render, profile::Region::traversal}) {
-            const profile::EventCounts c =
-                profile::run_callgrind(child_command(o.scene, config, ro, r), profile::callgrind_options(r));
-            (r == profile::Region::render ? counts.render : counts.traversal) = c;
-        }
+    for (const profile::Region r : {profile::Region::render, profile::Region::traversal}) {
+        const profile::EventCounts c =
+            profile::run_callgrind(child_command(scene_spec, config, ro, r), profile::callgrind_options(r));
+        (r == profile::Region::render ? counts.render : counts.traversal) = c;
     }
+    return counts;
+}
+
+// What one profile measured, for the JSON file.
+struct Profile {
+    AccelStats structure;
+    AccelConfig config;
+    RenderOptions frame;
+    bool hardware = false;
+    double native_seconds = 0.0;
+    RenderStats work;
+    TraversalCounters all;  // primary and shadow rays together
+    profile::RegionCounts counts;
+};
+
+nlohmann::json profile_json(const Scene& scene, const ProfileOptions& o, const Profile& p) {
+    const AccelStats& st = p.structure;
+    const TraversalCounters& all = p.all;
+    nlohmann::json j = {{"scene", scene.name},
+                        {"triangles", scene.triangles.size()},
+                        {"accel", st.name},
+                        {"traversal", st.traversal},
+                        {"simd", st.simd_lanes ? p.config.simd : "off"},
+                        {"simd_lanes", st.simd_lanes ? std::to_string(st.simd_lanes) : "off"},
+                        {"params", o.accel.params},
+                        {"width", p.frame.width},
+                        {"height", p.frame.height},
+                        {"packet", p.frame.packet},
+                        {"method", p.hardware ? "hardware" : "callgrind"},
+                        {"native_render_cpu_seconds", p.native_seconds}};
+    j["rays"] = {{"primary", p.work.primary_rays}, {"shadow", p.work.secondary_rays}, {"all", all.rays}};
+    j["work"] = {{"nodes", all.nodes},
+                 {"leaves", all.leaves},
+                 {"triangles", all.triangles},
+                 {"per_ray",
+                  {{"nodes", per(all.nodes, all.rays)},
+                   {"leaves", per(all.leaves, all.rays)},
+                   {"triangles", per(all.triangles, all.rays)}}}};
+    j["regions"] = {{"render", to_json(p.counts.render, all.rays)},
+                    {"traversal", to_json(p.counts.traversal, all.rays)}};
+    return j;
+}
+
+int run_profile(const ProfileOptions& o) {
+    Profile p;
+    p.hardware = use_hardware_counters(o.method);
+    if (!o.json.empty() && !o.overwrite && std::filesystem::exists(o.json))
+        throw Error(o.json + ": file exists (pass --overwrite to replace it)");
+    p.config = profiled_config(o.accel, p.hardware);
+    const Scene scene = load_scene(o.scene);
+    p.frame = profiled_frame(scene, o, p.hardware);
+    const auto accel = build_structure(scene.triangles, p.config);
+    p.structure = accel->stats();
+    print_setup(scene, p.structure, p.config, p.frame, p.hardware, o.size.empty());
+
+    p.native_seconds = native_render_seconds(scene, *accel, p.frame);
+    p.work = counted_work(scene, *accel, p.frame);
+    p.all = p.work.primary;
+    p.all += p.work.secondary;
+    p.counts = event_counts(scene, *accel, p.frame, o.scene, p.config, p.hardware);
 
     std::printf("rays                   %s primary + %s shadow = %s; native render %.4f s CPU (best of %d)\n",
-                with_commas(work.primary_rays).c_str(), with_commas(work.secondary_rays).c_str(),
-                with_commas(all.rays).c_str(), native_seconds, kTimedRenders);
-    print_report(counts, all);
-
-    if (!o.json.empty()) {
-        nlohmann::json j = {{"scene", scene.name},
-                            {"triangles", scene.triangles.size()},
-                            {"accel", st.name},
-                            {"traversal", st.traversal},
-                            {"simd", st.simd_lanes ? config.simd : "off"},
-                            {"simd_lanes", st.simd_lanes ? std::to_string(st.simd_lanes) : "off"},
-                            {"params", o.accel.params},
-                            {"width", ro.width},
-                            {"height", ro.height},
-                            {"packet", ro.packet},
-                            {"method", hardware ? "hardware" : "callgrind"},
-                            {"native_render_cpu_seconds", native_seconds}};
-        j["rays"] = {{"primary", work.primary_rays}, {"shadow", work.secondary_rays}, {"all", all.rays}};
-        j["work"] = {{"nodes", all.nodes},
-                     {"leaves", all.leaves},
-                     {"triangles", all.triangles},
-                     {"per_ray",
-                      {{"nodes", per(all.nodes, all.rays)},
-                       {"leaves", per(all.leaves, all.rays)},
-                       {"triangles", per(all.triangles, all.rays)}}}};
-        j["regions"] = {{"render", to_json(counts.render, all.rays)},
-                        {"traversal", to_json(counts.traversal, all.rays)}};
-        write_file_atomically(o.json, j.dump(1) + "\n", o.overwrite);
-    }
+                with_commas(p.work.primary_rays).c_str(), with_commas(p.work.secondary_rays).c_str(),
+                with_commas(p.all.rays).c_str(), p.native_seconds, kTimedRenders);
+    print_report(p.counts, p.all);
+    if (!o.json.empty()) write_file_atomically(o.json, profile_json(scene, o, p).dump(1) + "\n", o.overwrite);
     return 0;
 }
 

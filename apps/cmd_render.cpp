@@ -8,7 +8,6 @@
 #include <filesystem>
 
 #include "accel/local_store_registry.hpp"
-#include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
@@ -70,23 +69,6 @@ struct LocalStoreOptions {
 // The library's error for what the user gave as `option`, under the option's name: the library speaks
 // of what the value means, the user typed the option.
 Error option_error(const std::string& option, const Error& e) { return Error(option + ": " + e.what()); }
-
-// The structure for `config`. Where it is refused and the library refuses the SIMD set too, the error
-// is the --simd option's (looked at only after a refusal: Embree ignores the set, and a bad one is no
-// error for it).
-std::unique_ptr<Accelerator> make_structure(const Scene& scene, const AccelConfig& config) {
-    try {
-        return make_accelerator(scene.triangles, config);
-    } catch (const Error&) {
-        if (config.simd == "off") throw;
-        try {
-            detail::parse_isa(config.simd);
-        } catch (const Error& e) {
-            throw option_error("--simd", e);
-        }
-        throw;
-    }
-}
 
 // --shading and --ao-samples; `ao_samples_given` is whether the user typed the latter, which means
 // nothing for another shading.
@@ -242,7 +224,8 @@ Runner add_render(CLI::App& app) {
             if (o->accel.simd_option->count() == 0) config.simd = "off";
             modelled = make_local_store_accelerator(scene.triangles, config, local_store);
         }
-        const std::unique_ptr<Accelerator> direct = modelled ? nullptr : make_structure(scene, o->accel.config());
+        const std::unique_ptr<Accelerator> direct =
+            modelled ? nullptr : build_structure(scene.triangles, o->accel.config());
         const Accelerator& accel = modelled ? *modelled : *direct;
         Progress progress;
         ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -54,176 +55,229 @@ double median_of_rounds(int rounds, F&& f) {
     return median(v);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size, Embree alongside"};
+struct Options {
     std::string scenes_dir = "../shared/scenes";
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
     std::vector<std::string> configs{"embree:single", "kd+auto", "bih+auto", "kd:branched"};
     std::vector<std::string> dispatches{"pull", "mailbox"};
     std::vector<int> packets{2, 8, 16};
-    std::vector<unsigned> workers;
+    std::vector<unsigned> workers;  // sorted, without repeats
     int repeats = 3;
     std::string size = "512x512";
     std::string csv_path, json_path;
     int idle_spin = static_cast<int>(kDefaultIdleSpin.count());
     bool pin = false;
-    app.add_option("--scenes-dir", scenes_dir, "Folder of the shared scenes")->capture_default_str();
-    app.add_option("--scenes", scenes, "Shared scene names or builtin:... specs")->capture_default_str();
-    app.add_option("--configs", configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
+};
+
+// Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
+// option), as CLI11_PARSE would.
+std::optional<int> parse_options(int argc, char** argv, Options& o) {
+    CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size, Embree alongside"};
+    app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
+    app.add_option("--scenes", o.scenes, "Shared scene names or builtin:... specs")->capture_default_str();
+    app.add_option("--configs", o.configs, "KIND[:TRAVERSAL][+SIMD]; the first embree one is the yardstick")
         ->capture_default_str();
     // Checked here, so that CLI11 names the option in front of the library's message.
-    app.add_option("--dispatch", dispatches, "Dispatch modes")->capture_default_str()->check([](const std::string& d) {
-        try {
-            parse_dispatch(d);
-            return std::string();
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-    });
-    app.add_option("--packets", packets, "Packet edges P (P x P rays)")
+    app.add_option("--dispatch", o.dispatches, "Dispatch modes")
+        ->capture_default_str()
+        ->check([](const std::string& d) {
+            try {
+                parse_dispatch(d);
+                return std::string();
+            } catch (const Error& e) {
+                return std::string(e.what());
+            }
+        });
+    app.add_option("--packets", o.packets, "Packet edges P (P x P rays)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPacket));
-    app.add_option("--workers", workers, "Worker counts (default 1..cores)");
-    app.add_option("--repeats", repeats, "Timed frames per point (median)")->capture_default_str()->check(CLI::Range(1, 100));
-    app.add_option("--size", size, "Image size WxH (the study's: 512x512)")->capture_default_str();
-    app.add_option("--idle-spin-us", idle_spin, "Microseconds the workers poll for the next frame before sleeping")
+    app.add_option("--workers", o.workers, "Worker counts (default 1..cores)");
+    app.add_option("--repeats", o.repeats, "Timed frames per point (median)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
+    app.add_option("--size", o.size, "Image size WxH (the study's: 512x512)")->capture_default_str();
+    app.add_option("--idle-spin-us", o.idle_spin, "Microseconds the workers poll for the next frame before sleeping")
         ->capture_default_str()
         ->check(CLI::Range(0, 1000000));
-    app.add_flag("--pin", pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
-    app.add_option("--csv", csv_path, "Write every point as CSV");
-    app.add_option("--json", json_path, "Write every point as JSON");
-    CLI11_PARSE(app, argc, argv);
-    if (workers.empty())
-        for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) workers.push_back(w);
-    std::sort(workers.begin(), workers.end());  // efficiencies are against the fewest
-    workers.erase(std::unique(workers.begin(), workers.end()), workers.end());
+    app.add_flag("--pin", o.pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
+    app.add_option("--csv", o.csv_path, "Write every point as CSV");
+    app.add_option("--json", o.json_path, "Write every point as JSON");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    if (o.workers.empty())
+        for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) o.workers.push_back(w);
+    std::sort(o.workers.begin(), o.workers.end());  // efficiencies are against the fewest
+    o.workers.erase(std::unique(o.workers.begin(), o.workers.end()), o.workers.end());
+    return std::nullopt;
+}
 
+// The first embree configuration, which every table is a ratio to; empty where there is none.
+std::string yardstick_of(const std::vector<std::string>& configs) {
+    for (const std::string& c : configs)
+        if (parse_accel_config(c).kind == "embree") return c;
+    return {};
+}
+
+// One worker count's timed frames, one figure a round; the loads are summed over its workers.
+struct Rounds {
+    std::vector<double> seconds, busy, started, waiting;
+};
+
+// The timed frames of one scene, structure, dispatch and packet size, by worker count.
+struct Timings {
+    std::map<unsigned, Rounds> by_workers;
+    std::uint64_t rays = 0;  // a frame's, the same for every worker count
+};
+
+// A warm-up frame per worker count, then --repeats rounds over the worker counts: interleaved, so that
+// a machine whose speed drifts (shared hosts do) shifts every count alike and efficiencies hold.
+Timings timed_frames(const Scene& scene, const Accelerator& accel, RenderOptions ro, const Options& o) {
+    Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
+    for (unsigned w : o.workers) {
+        ro.threads = w;
+        render(scene, accel, ro, frame);
+    }
+    Timings t;
+    RenderStats st;
+    for (int r = 0; r < o.repeats; ++r)
+        for (unsigned w : o.workers) {
+            ro.threads = w;
+            // Frames drawn back to back, as a renderer draws them: the timed frame follows one with the
+            // same workers, so it finds them still polling (RenderOptions::idle_spin), not asleep after
+            // other worker counts.
+            render(scene, accel, ro, frame);
+            render(scene, accel, ro, frame, &st);
+            Rounds& rounds = t.by_workers[w];
+            rounds.seconds.push_back(st.seconds);
+            double b = 0.0, s = 0.0, e = 0.0;
+            for (const WorkerLoad& l : st.workers) {
+                b += l.busy_seconds;
+                s += l.started_seconds;
+                e += std::max(0.0, st.seconds - l.finished_seconds);
+            }
+            rounds.busy.push_back(b);
+            rounds.started.push_back(s);
+            rounds.waiting.push_back(e);
+            t.rays = st.primary_rays + st.secondary_rays;
+        }
+    return t;
+}
+
+// The points of one scene, structure, dispatch and packet size, a worker count each, appended to
+// `points` with a progress line each on stderr.
+void add_points(const Timings& t, const std::string& scene, const std::string& config, const std::string& dispatch,
+                int packet, const Options& o, std::vector<Point>& points) {
+    const unsigned first = o.workers.front();
+    const Rounds& base = t.by_workers.at(first);
+    for (unsigned w : o.workers) {
+        const Rounds& rounds = t.by_workers.at(w);
+        const double efficiency = median_of_rounds(o.repeats, [&](std::size_t r) {
+            return base.seconds[r] * first / (rounds.seconds[r] * w);
+        });
+        const double packet_time_ratio =
+            median_of_rounds(o.repeats, [&](std::size_t r) { return rounds.busy[r] / base.busy[r]; });
+        points.push_back({scene, config, dispatch, packet, w, median(rounds.seconds), median(rounds.busy),
+                          median(rounds.started), median(rounds.waiting), efficiency, packet_time_ratio, t.rays});
+        std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.c_str(), config.c_str(), dispatch.c_str(),
+                     packet, packet, w, points.back().seconds);
+    }
+}
+
+// Every point measured, and the names of the scenes that were there.
+struct Study {
     std::vector<Point> points;
     std::vector<std::string> scene_names;
-    std::string yardstick;
-    for (const std::string& c : configs)
-        if (yardstick.empty() && parse_accel_config(c).kind == "embree") yardstick = c;
-    try {
-        const auto [width, height] = parse_image_size("--size", size);
-        for (const std::string& name : scenes) {
-            const auto spec = bench::scene_spec(scenes_dir, name);
-            if (!spec) continue;
-            const Scene scene = load_scene(*spec);
-            scene_names.push_back(scene.name);
-            for (const std::string& cfg_text : configs) {
-                const AccelConfig cfg = parse_accel_config(cfg_text);
-                if (!bench::built_in(cfg.kind)) continue;
-                const auto accel = make_accelerator(scene.triangles, cfg);
-                for (const std::string& d : dispatches)
-                    for (int p : packets) {
-                        // Worker counts are interleaved round by round, so that a machine whose speed
-                        // drifts (shared hosts do) shifts every count alike and efficiencies hold.
-                        auto options = [&](unsigned w) {
-                            RenderOptions o;
-                            o.width = width;
-                            o.height = height;
-                            o.threads = w;
-                            o.packet = p;
-                            o.dispatch = parse_dispatch(d);
-                            o.idle_spin = std::chrono::microseconds(idle_spin);
-                            o.pin = pin;
-                            return o;
-                        };
-                        Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
-                        for (unsigned w : workers) render(scene, *accel, options(w), frame);  // warm-up
-                        std::map<unsigned, std::vector<double>> times, busy, started, waiting;
-                        RenderStats st;
-                        for (int r = 0; r < repeats; ++r)
-                            for (unsigned w : workers) {
-                                // Frames drawn back to back, as a renderer draws them: the timed frame
-                                // follows one with the same workers, so it finds them still polling
-                                // (RenderOptions::idle_spin), not asleep after other worker counts.
-                                render(scene, *accel, options(w), frame);
-                                render(scene, *accel, options(w), frame, &st);
-                                times[w].push_back(st.seconds);
-                                double b = 0.0, s = 0.0, e = 0.0;
-                                for (const WorkerLoad& l : st.workers) {
-                                    b += l.busy_seconds;
-                                    s += l.started_seconds;
-                                    e += std::max(0.0, st.seconds - l.finished_seconds);
-                                }
-                                busy[w].push_back(b);
-                                started[w].push_back(s);
-                                waiting[w].push_back(e);
-                            }
-                        const unsigned first = workers.front();
-                        for (unsigned w : workers) {
-                            const double efficiency = median_of_rounds(repeats, [&](std::size_t r) {
-                                return times[first][r] * first / (times[w][r] * w);
-                            });
-                            const double packet_time_ratio =
-                                median_of_rounds(repeats, [&](std::size_t r) { return busy[w][r] / busy[first][r]; });
-                            points.push_back({scene.name, cfg_text, d, p, w, median(times[w]), median(busy[w]),
-                                              median(started[w]), median(waiting[w]), efficiency, packet_time_ratio,
-                                              st.primary_rays + st.secondary_rays});
-                            std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.name.c_str(),
-                                         cfg_text.c_str(), d.c_str(), p, p, w, points.back().seconds);
-                        }
-                    }
-            }
+};
+
+// Every scene, then every structure this binary has, dispatch mode and packet size, in that nesting:
+// each structure is built once and measured for all the dispatch modes and packet sizes.
+Study measure(const Options& o) {
+    Study study;
+    const auto [width, height] = parse_image_size("--size", o.size);
+    for (const std::string& name : o.scenes) {
+        const auto spec = bench::scene_spec(o.scenes_dir, name);
+        if (!spec) continue;
+        const Scene scene = load_scene(*spec);
+        study.scene_names.push_back(scene.name);
+        for (const std::string& cfg_text : o.configs) {
+            const AccelConfig cfg = parse_accel_config(cfg_text);
+            if (!bench::built_in(cfg.kind)) continue;
+            const auto accel = make_accelerator(scene.triangles, cfg);
+            for (const std::string& d : o.dispatches)
+                for (int p : o.packets) {
+                    RenderOptions ro;
+                    ro.width = width;
+                    ro.height = height;
+                    ro.packet = p;
+                    ro.dispatch = parse_dispatch(d);
+                    ro.idle_spin = std::chrono::microseconds(o.idle_spin);
+                    ro.pin = o.pin;
+                    add_points(timed_frames(scene, *accel, ro, o), scene.name, cfg_text, d, p, o, study.points);
+                }
         }
-    } catch (const Error& e) {
-        std::fprintf(stderr, "cellrt_scaling: error: %s\n", e.what());
-        return 1;
     }
+    return study;
+}
 
-    auto find = [&](const std::string& scene, const std::string& config, const std::string& d, int p,
-                    unsigned w) -> const Point* {
-        for (const Point& pt : points)
-            if (pt.scene == scene && pt.config == config && pt.dispatch == d && pt.packet == p && pt.workers == w)
-                return &pt;
-        return nullptr;
-    };
-    // One table per configuration, dispatch and packet size, shaped like the study's: rows scenes,
-    // columns workers, seconds per frame with cellrt's rays/s over Embree's, and the parallel
-    // efficiency at the most workers; then where the time of the most workers went.
-    const unsigned one = workers.front(), most = workers.back();
-    for (const std::string& config : configs)
-        for (const std::string& d : dispatches)
-            for (int p : packets) {
-                std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |",
-                            config.c_str(), d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
-                for (unsigned w : workers) std::printf(" %u |", w);
-                std::printf(" efficiency at %u |\n|---|", most);
-                for (std::size_t i = 0; i <= workers.size(); ++i) std::printf("---|");
-                std::printf("\n");
-                for (const std::string& scene : scene_names) {
-                    std::printf("| %s |", scene.c_str());
-                    for (unsigned w : workers) {
-                        const Point* pt = find(scene, config, d, p, w);
-                        const Point* y = yardstick.empty() ? nullptr : find(scene, yardstick, d, p, w);
-                        if (!pt) std::printf(" – |");
-                        else if (y) std::printf(" %.4f (%.2f×) |", pt->seconds, y->seconds / pt->seconds);
-                        else std::printf(" %.4f |", pt->seconds);
-                    }
-                    const Point* last = find(scene, config, d, p, most);
-                    if (last) std::printf(" %.2f |\n", last->efficiency);
-                    else std::printf(" – |\n");
-                }
-                // The workers' time at the most workers (most x seconds), in shares: tracing packets,
-                // and the schedule's parts; efficiency is about the tracing share over the packet time.
-                std::printf("\nWhere the %u workers' time went (shares of %u × the frame):\n\n"
-                            "| scene | tracing | waking | between packets | waiting at the end | packet time %u ÷ %u |\n"
-                            "|---|---|---|---|---|---|\n",
-                            most, most, most, one);
-                for (const std::string& scene : scene_names) {
-                    const Point* last = find(scene, config, d, p, most);
-                    if (!last) continue;
-                    const double all = last->seconds * most;
-                    const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
-                                 waiting = last->waiting_seconds / all;
-                    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", scene.c_str(), tracing, waking,
-                                std::max(0.0, 1.0 - tracing - waking - waiting), waiting, last->packet_time_ratio);
-                }
-            }
+const Point* find(const std::vector<Point>& points, const std::string& scene, const std::string& config,
+                  const std::string& d, int p, unsigned w) {
+    for (const Point& pt : points)
+        if (pt.scene == scene && pt.config == config && pt.dispatch == d && pt.packet == p && pt.workers == w)
+            return &pt;
+    return nullptr;
+}
 
+// Shaped like the study's: rows scenes, columns workers, seconds per frame with cellrt's rays/s over
+// the yardstick's, and the parallel efficiency at the most workers.
+void print_seconds_table(const Study& study, const Options& o, const std::string& yardstick,
+                         const std::string& config, const std::string& d, int p) {
+    const unsigned most = o.workers.back();
+    std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |", config.c_str(),
+                d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
+    for (unsigned w : o.workers) std::printf(" %u |", w);
+    std::printf(" efficiency at %u |\n|---|", most);
+    for (std::size_t i = 0; i <= o.workers.size(); ++i) std::printf("---|");
+    std::printf("\n");
+    for (const std::string& scene : study.scene_names) {
+        std::printf("| %s |", scene.c_str());
+        for (unsigned w : o.workers) {
+            const Point* pt = find(study.points, scene, config, d, p, w);
+            const Point* y = yardstick.empty() ? nullptr : find(study.points, scene, yardstick, d, p, w);
+            if (!pt) std::printf(" – |");
+            else if (y) std::printf(" %.4f (%.2f×) |", pt->seconds, y->seconds / pt->seconds);
+            else std::printf(" %.4f |", pt->seconds);
+        }
+        const Point* last = find(study.points, scene, config, d, p, most);
+        if (last) std::printf(" %.2f |\n", last->efficiency);
+        else std::printf(" – |\n");
+    }
+}
+
+// The workers' time at the most workers (most x seconds), in shares: tracing packets, and the
+// schedule's parts; efficiency is about the tracing share over the packet time.
+void print_time_shares(const Study& study, const Options& o, const std::string& config, const std::string& d, int p) {
+    const unsigned one = o.workers.front(), most = o.workers.back();
+    std::printf("\nWhere the %u workers' time went (shares of %u × the frame):\n\n"
+                "| scene | tracing | waking | between packets | waiting at the end | packet time %u ÷ %u |\n"
+                "|---|---|---|---|---|---|\n",
+                most, most, most, one);
+    for (const std::string& scene : study.scene_names) {
+        const Point* last = find(study.points, scene, config, d, p, most);
+        if (!last) continue;
+        const double all = last->seconds * most;
+        const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
+                     waiting = last->waiting_seconds / all;
+        std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", scene.c_str(), tracing, waking,
+                    std::max(0.0, 1.0 - tracing - waking - waiting), waiting, last->packet_time_ratio);
+    }
+}
+
+// Every point, with the yardstick's seconds for the same scene, dispatch, packet size and workers
+// where it was measured.
+nlohmann::json points_json(const std::vector<Point>& points, const std::string& yardstick) {
     nlohmann::json out = nlohmann::json::array();
     for (const Point& pt : points) {
         nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
@@ -231,20 +285,50 @@ int main(int argc, char** argv) {
                          {"busy_seconds", pt.busy_seconds}, {"started_seconds", pt.started_seconds},
                          {"waiting_seconds", pt.waiting_seconds}, {"efficiency", pt.efficiency},
                          {"packet_time_ratio", pt.packet_time_ratio}, {"rays", pt.rays}};
-        if (const Point* y = yardstick.empty() ? nullptr : find(pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
+        if (const Point* y =
+                yardstick.empty() ? nullptr : find(points, pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;
         out.push_back(j);
     }
-    if (!json_path.empty()) std::ofstream(json_path) << out.dump(1) << "\n";
-    if (!csv_path.empty()) {
-        std::ofstream csv(csv_path);
-        csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,efficiency,"
-               "packet_time_ratio,rays,embree_seconds\n";
-        for (const auto& j : out)
-            csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
-                << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
-                << ',' << j["busy_seconds"] << ',' << j["started_seconds"]
-                << ',' << j["waiting_seconds"] << ',' << j["efficiency"] << ',' << j["packet_time_ratio"] << ',' << j["rays"] << ',' << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+    return out;
+}
+
+// The JSON rows as CSV, a column each; embree_seconds is empty where there was no yardstick.
+void write_csv(const std::string& path, const nlohmann::json& rows) {
+    std::ofstream csv(path);
+    csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,efficiency,"
+           "packet_time_ratio,rays,embree_seconds\n";
+    for (const auto& j : rows)
+        csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
+            << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
+            << ',' << j["busy_seconds"] << ',' << j["started_seconds"] << ',' << j["waiting_seconds"] << ','
+            << j["efficiency"] << ',' << j["packet_time_ratio"] << ',' << j["rays"] << ','
+            << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options o;
+    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
+    std::string yardstick;
+    Study study;
+    try {
+        yardstick = yardstick_of(o.configs);  // parses the configurations: a bad one is the user's error
+        study = measure(o);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "cellrt_scaling: error: %s\n", e.what());
+        return 1;
     }
+    // One table per configuration, dispatch and packet size; then where the time of the most workers went.
+    for (const std::string& config : o.configs)
+        for (const std::string& d : o.dispatches)
+            for (int p : o.packets) {
+                print_seconds_table(study, o, yardstick, config, d, p);
+                print_time_shares(study, o, config, d, p);
+            }
+    const nlohmann::json out = points_json(study.points, yardstick);
+    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
+    if (!o.csv_path.empty()) write_csv(o.csv_path, out);
     return 0;
 }

@@ -171,6 +171,8 @@ TEST(Cli, NamesTheOptionAtFault) {
              {{"render", "--shading", "phong", "-o", out}, "--shading: shading 'phong' is not one of: direct, ao, diffuse"},
              {{"render", "--shading", "ao", "--ao-samples", "65", "-o", out}, "--ao-samples 65 must lie in [1, 64]"},
              {{"render", "--ao-samples", "4", "-o", out}, "--ao-samples needs --shading ao"},
+             {{"info", "builtin:spheres?tris=100", "--accel", "kd", "--simd", "avx9"},
+              "--simd: SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
          }) {
         std::vector<std::string> all{CELLRT_CLI};
         all.insert(all.end(), args.begin(), args.end());

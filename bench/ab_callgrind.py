@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""A/B of two cellrt_bench builds by instruction counts. Each binary runs under callgrind on the
+same rays. For every scene, configuration and ray kind, the script reports the instructions (Ir) of
+one timed pass: primary rays through intersect, shadow rays through occluded. Each count is the
+inclusive cost of the bench's calls into the accelerator's entry point, so building the structures
+and making the rays are left out.
+
+Why: on the shared VM, times of whole runs vary by +-10% (docs/BENCHMARKS.md), which is more than
+the 2% to be shown. Instruction counts repeat exactly from run to run. They are not time: they do
+not see cache misses, mispredicted branches or which instructions run. But a refactor that only
+moves code barely changes them, so a ratio near 1 is the evidence, and a larger one shows where to
+look.
+
+How: callgrind starts a new dump each time clock_gettime is called (--dump-before), and cellrt_bench
+reads the clock just before and just after every pass. So each pass is a dump of its own, whether a
+run traces one configuration or all of them (the counts are the same either way). A round is a
+primary dump, then tiny gap dumps only, then a shadow dump. For each scene the bench runs one
+warm-up round per configuration, then --repeats more; the last round is the one reported. Under
+valgrind '+auto' resolves to avx2, because valgrind has no AVX-512.
+
+    bench/ab_callgrind.py OLD NEW --json out.json [--keep DIR] -- [cellrt_bench options]
+"""
+import argparse
+import glob
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ENTRY = re.compile(r"^[\w:<>, ]*::(intersect|occluded)\(std::span<cellrt::Ray const")
+
+
+def option_values(args, name, default):
+    if name not in args:
+        return default
+    i = args.index(name) + 1
+    vals = []
+    while i < len(args) and not args[i].startswith("--"):
+        vals.append(args[i])
+        i += 1
+    return vals
+
+
+def without_option(args, name):
+    if name not in args:
+        return list(args)
+    i = args.index(name)
+    j = i + 1
+    while j < len(args) and not args[j].startswith("--"):
+        j += 1
+    return args[:i] + args[j:]
+
+
+def dump_counts(path):
+    """(total Ir, intersect Ir, occluded Ir) of one callgrind dump: the inclusive cost of the calls
+    into an accelerator's intersect/occluded from outside one (the bench's loop)."""
+    names, fn, cfn, total = {}, "", "", 0
+    ir = {"intersect": 0, "occluded": 0}
+    lines = iter(open(path, errors="replace"))
+    for line in lines:
+        if line.startswith(("fn=", "cfn=")):
+            key, _, rest = line.rstrip("\n").partition("=")
+            ident, _, name = rest.partition(" ")
+            if name:
+                names[ident] = name
+            if key == "fn":
+                fn = names.get(ident, ident)
+            else:
+                cfn = names.get(ident, ident)
+        elif line.startswith("calls="):
+            cost = int(next(lines).split()[1])
+            e = ENTRY.match(cfn.replace("(anonymous namespace)", "anon"))
+            if e and not ENTRY.match(fn.replace("(anonymous namespace)", "anon")):
+                ir[e.group(1)] += cost
+        elif line.startswith(("summary:", "totals:")):
+            total = int(line.split()[1])
+    return total, ir["intersect"], ir["occluded"]
+
+
+def run(binary, configs, args, keep):
+    """{(config, scene): {primary, shadow, rounds, rays, work}} from one callgrind run of `configs`."""
+    d = tempfile.mkdtemp(prefix="ab_cg_", dir=keep)
+    bench_json = os.path.join(d, "bench.json")
+    cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={d}/cg.out", "--dump-before=*clock_gettime*",
+           binary, *without_option(without_option(args, "--configs"), "--json"), "--configs", *configs,
+           "--json", bench_json]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        sys.exit(f"{' '.join(cmd)} failed:\n{res.stderr[-2000:]}")
+    files = sorted(glob.glob(f"{d}/cg.out.*"), key=lambda p: int(p.rsplit(".", 1)[1]))
+    dumps = [dump_counts(p) for p in files]
+    rounds, i = [], 0
+    while i < len(dumps):
+        t, ni, no = dumps[i]
+        if ni > 0 and no == 0 and ni > 0.99 * t:
+            j = i + 1
+            while j < len(dumps) and dumps[j][0] < 10000:
+                j += 1
+            if j < len(dumps) and dumps[j][2] > 0 and dumps[j][1] == 0 and dumps[j][2] > 0.99 * dumps[j][0]:
+                rounds.append((ni, dumps[j][2]))
+                i = j
+        i += 1
+    # Per scene, the bench traces its configurations in turn: a warm-up round, then --repeats rounds.
+    rows = json.load(open(bench_json))
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    traced = [[r for r in rows if r["scene"] == s] for s in scenes]
+    passes = 1 + int(option_values(args, "--repeats", ["5"])[0])
+    if len(rounds) != passes * len(rows):
+        sys.exit(f"{binary}: {len(rounds)} pass rounds for {len(rows)} (scene, config) rows x {passes}; "
+                 f"rerun with --keep to look at the dumps")
+    out, k = {}, 0
+    for rs in traced:
+        mine = rounds[k:k + passes * len(rs)]
+        k += passes * len(rs)
+        for j, r in enumerate(rs):
+            own = mine[j::len(rs)]
+            out[(r["config"], r["scene"])] = {
+                "primary": own[-1][0], "shadow": own[-1][1], "rounds": own, "primary_rays": r["primary_rays"],
+                "shadow_rays": r["shadow_rays"], "work": [r["primary_per_ray"], r["shadow_per_ray"]]}
+    if not keep:
+        for p in glob.glob(f"{d}/*"):
+            os.unlink(p)
+        os.rmdir(d)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("old")
+    ap.add_argument("new")
+    ap.add_argument("--json", required=True, help="write the counts and ratios here")
+    ap.add_argument("--keep", help="keep the callgrind dumps in folders under this one")
+    ap.add_argument("--one-config-per-run", action="store_true",
+                    help="one valgrind run per configuration (the counts are the same; the scenes load more often)")
+    argv = sys.argv[1:]
+    split = argv.index("--") if "--" in argv else len(argv)
+    o = ap.parse_args(argv[:split])
+    args = argv[split + 1:]
+    configs = option_values(args, "--configs", ["kd:rec", "kd:branched", "kd:branchless", "kd+auto",
+                                                "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"])
+    groups = [[c] for c in configs] if o.one_config_per_run else [configs]
+    results = []
+    print("| config | scene | kind | Ir old | Ir new | new/old |\n|---|---|---|---|---|---|", flush=True)
+    for g in groups:
+        old, new = run(o.old, g, args, o.keep), run(o.new, g, args, o.keep)
+        for key in old:
+            c, s = key
+            if old[key]["work"] != new[key]["work"] or old[key]["primary_rays"] != new[key]["primary_rays"]:
+                print(f"warning: {c} {s}: old and new traced different rays or did different work", file=sys.stderr)
+            for kind in ("primary", "shadow"):
+                a, b = old[key][kind], new[key][kind]
+                results.append({"config": c, "scene": s, "kind": kind, "rays": old[key][kind + "_rays"],
+                                "ir_old": a, "ir_new": b, "ratio": b / a,
+                                "passes_old": [r[kind == "shadow"] for r in old[key]["rounds"]],
+                                "passes_new": [r[kind == "shadow"] for r in new[key]["rounds"]]})
+                print(f"| {c} | {s} | {kind} | {a:,} | {b:,} | {b / a:.4f} |", flush=True)
+    cell = [r["ratio"] for r in results if not r["config"].startswith("embree")]
+    summary = {}
+    if cell:
+        summary = {"points": len(cell), "max": max(cell), "min": min(cell),
+                   "geomean": math.exp(sum(map(math.log, cell)) / len(cell)),
+                   "above_1.02": [f'{r["config"]} {r["scene"]} {r["kind"]}' for r in results
+                                  if not r["config"].startswith("embree") and r["ratio"] > 1.02]}
+        print(f"\ncellrt points: {len(cell)}, new/old geomean {summary['geomean']:.4f}, "
+              f"min {summary['min']:.4f}, max {summary['max']:.4f}, above 1.02: {summary['above_1.02'] or 'none'}")
+    with open(o.json, "w") as f:
+        json.dump({"old": o.old, "new": o.new, "bench_args": args, "measure": "callgrind Ir, one timed pass",
+                   "summary": summary, "results": results}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
