@@ -264,7 +264,7 @@ Runner add_cache_study(CLI::App& app) {
                             for (const CacheLayout& layout : swept_layouts()) {
                                 Run run{structure, traversal, sweep, LocalStoreConfig{}};
                                 run.config.access = parse_cache_access("--access", access);
-                                run.config.packet_rays = static_cast<std::size_t>(o->packet) * o->packet;
+                                run.config.batch_rays = static_cast<std::size_t>(o->packet) * o->packet;
                                 run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
                                 run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
                                 runs.push_back(run);

@@ -61,7 +61,7 @@ struct LocalStoreOptions {
         if (kib < 16 || kib > 16384)
             throw Error("--local-store-kib " + std::to_string(kib) + " must lie in [16, 16384]");
         c.budget_bytes = static_cast<std::size_t>(kib) * 1024;
-        c.packet_rays = static_cast<std::size_t>(packet) * packet;
+        c.batch_rays = static_cast<std::size_t>(packet) * packet;
         return c;
     }
 };

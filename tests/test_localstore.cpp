@@ -193,7 +193,7 @@ TEST(CacheLayout, ParsesAndRefusesWithTheOptionNamed) {
 }
 
 TEST(LocalStoreBudget, RefusesByHowMuch) {
-    // kd branchless: stack (60 + 2) x 12 = 744 bytes; packet 256 x (32 + 16) = 12288 bytes.
+    // kd branchless: stack (60 + 2) x 12 = 744 bytes; batch 256 x (32 + 16) = 12288 bytes.
     LocalStoreConfig c;
     c.node_cache = {4096, 32, 1};      // 131072 + 32 x 8 directory = 131328
     c.triangle_cache = {4096, 32, 1};  // 131328
@@ -224,9 +224,9 @@ TEST(LocalStoreBudget, RefusesByHowMuch) {
     with_param.params["leaf_size"] = "-1";
     EXPECT_THROW(make_local_store_accelerator(scene.triangles, with_param, ok), Error);
     EXPECT_THROW(make_local_store_accelerator(scene.triangles, AccelConfig{"bih", "rec"}, ok), Error);
-    AccelConfig packets{"kd"};
-    packets.simd = "auto";
-    EXPECT_THROW(make_local_store_accelerator(scene.triangles, packets, ok), Error);
+    AccelConfig simd_packets{"kd"};
+    simd_packets.simd = "auto";
+    EXPECT_THROW(make_local_store_accelerator(scene.triangles, simd_packets, ok), Error);
     ok.node_cache.ways = 2;
     EXPECT_THROW(make_local_store_accelerator(scene.triangles, AccelConfig{"bih"}, ok), Error);
 }
@@ -240,7 +240,7 @@ std::vector<LocalStoreConfig> model_configs() {
         c.node_cache = node;
         c.triangle_cache = tri;
         c.access = access;
-        c.packet_rays = 64;
+        c.batch_rays = 64;
         out.push_back(c);
     };
     add({128, 128, 1}, {128, 128, 1}, CacheAccess::sync);
@@ -317,7 +317,7 @@ TEST(LocalStoreModel, ImagesBitIdenticalToDirectMemory) {
         const Image direct = render(scene, *make_accelerator(scene.triangles, parse(structure)), small_render(2));
         const auto base = make_local_store_accelerator(scene.triangles, parse(structure), LocalStoreConfig{});
         for (LocalStoreConfig c : model_configs()) {
-            c.packet_rays = 64;
+            c.batch_rays = 64;
             const auto accel = base->with_local_store(c, parse(structure).traversal);
             RenderStats rs;
             EXPECT_TRUE(same_bits(render(scene, *accel, small_render(2), &rs), direct))

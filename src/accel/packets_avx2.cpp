@@ -1,5 +1,5 @@
-// The packet kernels of every listed structure compiled for avx2 (8 lanes), in a target region and a
-// namespace of their own.
+// The SIMD packet kernels of every listed structure compiled for avx2 (8 lanes), in a target
+// region and a namespace of their own.
 #include "accel/packet_isa.hpp"
 
 #if defined(__x86_64__)

@@ -1,4 +1,4 @@
-// The packet kernels with the compiler's generic vectors and no target (4 lanes): builds and
+// The SIMD packet kernels with the compiler's generic vectors and no target (4 lanes): builds and
 // runs on any processor.
 #include "accel/packet_isa.hpp"
 

@@ -16,7 +16,7 @@ const char* to_string(CacheAccess access) { return access == CacheAccess::sync ?
 std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& config, std::size_t stack_bytes) {
     validate_cache_layout(config.node_cache, "node cache " + config.node_cache.to_string());
     validate_cache_layout(config.triangle_cache, "triangle cache " + config.triangle_cache.to_string());
-    if (config.packet_rays == 0) throw Error("local store: a packet needs at least one ray");
+    if (config.batch_rays == 0) throw Error("local store: a batch needs at least one ray");
     auto cache = [](const char* name, const CacheLayout& l) {
         return LocalStoreAllocation{std::string(name) + " " + l.to_string(),
                                     l.capacity() + l.lines() * kDirectoryBytesPerLine};
@@ -25,8 +25,8 @@ std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& c
         cache("node cache", config.node_cache),
         cache("triangle cache", config.triangle_cache),
         {"traversal stack", stack_bytes},
-        {"packet of " + std::to_string(config.packet_rays) + " rays and results",
-         config.packet_rays * (sizeof(Ray) + sizeof(Hit))},
+        {"batch of " + std::to_string(config.batch_rays) + " rays and results",
+         config.batch_rays * (sizeof(Ray) + sizeof(Hit))},
     };
     std::size_t total = 0;
     for (const auto& a : allocations) total += a.bytes;

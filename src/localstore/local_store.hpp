@@ -1,6 +1,6 @@
 // The study's memory system of a worker core (Hapala, sections 4.3 and 5.2), as a model the very same
 // traversal kernels run through: each worker has a local store with a byte budget, holding a node
-// cache, a triangle cache, the traversal stack and the packet with its results. The kernels read only
+// cache, a triangle cache, the traversal stack and a batch of rays and results. The kernels read only
 // what the software caches copied in from main memory, synchronously (a read stalls until its line is
 // there) or asynchronously (touch the children when reading an inner node, wait when going to one),
 // and a cost model turns the work and the transfers into modelled cycles (cost_model.hpp). Hits are
@@ -37,7 +37,9 @@ struct LocalStoreConfig {
     // re-touch a wait trusts the slot its touch chose even when the line was evicted since (the
     // study's artifact): the kernel then reads another line's bytes.
     bool retouch = true;
-    std::size_t packet_rays = 256;  // rays of one packet in the local store (a P x P packet: P * P)
+    // Rays the local store holds at once, with their results: one batch. A call with more rays is
+    // traced batch by batch. `render` and `cache-study` make it the P * P rays of their P x P packet.
+    std::size_t batch_rays = 256;
     CostModel cost;
 };
 
@@ -57,7 +59,9 @@ inline constexpr std::size_t kDirectoryBytesPerLine = 8;
 struct LocalStoreStats {
     CacheStats node_cache, triangle_cache;
     std::uint64_t rays = 0;          // rays traced through the model (primary and shadow)
-    std::uint64_t packets = 0;       // packets loaded into a local store
+    // Batches loaded into a local store (WorkerStore::load_batch); a renderer's packet is two, its
+    // primary rays and its shadow rays (one when none of its primary rays hit).
+    std::uint64_t packets = 0;
     std::uint64_t cycles = 0;        // modelled cycles, summed over the workers
     std::uint64_t stall_cycles = 0;  // of which the workers waited for transfers
     std::uint64_t frame_cycles = 0;  // the busiest worker's cycles: the run's modelled duration

@@ -1,6 +1,6 @@
 // A tree traced through the local-store model: the structure is built as for direct memory, its
 // arrays are mapped into the model's main memory, and every worker thread runs the structure's own
-// kernels over CachedMemory and its own local store, packet by packet. A template over the
+// kernels over CachedMemory and its own local store, batch by batch. A template over the
 // structure's descriptor (kdtree/kd_structure.hpp), which the registry instantiates for every tree it
 // lists (accel/local_store_registry.cpp); the local store holds the stack the descriptor declares for
 // the traversal (stack_bytes).
@@ -124,7 +124,7 @@ public:
             s.node_cache += w.node_cache.stats;
             s.triangle_cache += w.triangle_cache.stats;
             s.rays += w.rays();
-            s.packets += w.packets();
+            s.packets += w.batches();
             s.cycles += w.cycles();
             s.stall_cycles += w.stall_cycles();
             s.frame_cycles = std::max(s.frame_cycles, w.cycles());
@@ -139,7 +139,7 @@ public:
     }
 
 private:
-    // Traces `count` rays on the calling thread's worker, one packet of the local store at a time:
+    // Traces `count` rays on the calling thread's worker, one batch of at most batch_rays at a time:
     // `batch(first, n, kernel)` runs the batch loop over rays [first, first + n) with `kernel`.
     template <class Batch>
     void trace(std::size_t count, std::size_t result_bytes, Batch&& batch) const {
@@ -154,9 +154,9 @@ private:
                                                                             cost.triangle_test};
                 return kernel(built_->structure.tree, mem, r, q, counted);
             };
-            for (std::size_t i = 0; i < count; i += config_.packet_rays) {
-                const std::size_t n = std::min(config_.packet_rays, count - i);
-                store.load_packet(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(n * sizeof(Ray)));
+            for (std::size_t i = 0; i < count; i += config_.batch_rays) {
+                const std::size_t n = std::min(config_.batch_rays, count - i);
+                store.load_batch(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(n * sizeof(Ray)));
                 batch(i, n, through_model);
                 store.store_results(static_cast<std::uint32_t>(n * result_bytes));
             }

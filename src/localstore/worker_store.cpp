@@ -71,8 +71,8 @@ void WorkerStore::touch(SoftwareCache& cache, std::uint64_t address, std::uint32
     }
 }
 
-void WorkerStore::load_packet(std::uint32_t rays, std::uint32_t bytes) {
-    ++packets_;
+void WorkerStore::load_batch(std::uint32_t rays, std::uint32_t bytes) {
+    ++batches_;
     rays_ += rays;
     wait_until(issue(bytes));
 }

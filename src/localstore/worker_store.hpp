@@ -42,15 +42,15 @@ public:
         ++ray_serial_;
         now_ += cost_.ray_setup;
     }
-    // A packet of `rays` rays comes in by DMA before its traversals (the worker waits for it); its
+    // A batch of `rays` rays comes in by DMA before its traversals (the worker waits for it); its
     // results go out by DMA behind it (the worker does not wait).
-    void load_packet(std::uint32_t rays, std::uint32_t bytes);
+    void load_batch(std::uint32_t rays, std::uint32_t bytes);
     void store_results(std::uint32_t bytes);
 
     std::uint64_t cycles() const { return now_; }
     std::uint64_t stall_cycles() const { return stall_; }
     std::uint64_t rays() const { return rays_; }
-    std::uint64_t packets() const { return packets_; }
+    std::uint64_t batches() const { return batches_; }
 
 private:
     // Where this ray's touches placed their lines: the pointer a kernel on the Cell keeps from its
@@ -93,7 +93,7 @@ private:
     const MainMemory* memory_;
     DmaEngine dma_;
     std::vector<TouchRecord> touched_;  // only for asynchronous access without re-touch
-    std::uint64_t now_ = 0, stall_ = 0, rays_ = 0, packets_ = 0;
+    std::uint64_t now_ = 0, stall_ = 0, rays_ = 0, batches_ = 0;
     std::uint64_t ray_serial_ = 0;  // rays traversed so far: touch records are valid within one
 };
 

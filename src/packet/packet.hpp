@@ -1,5 +1,6 @@
-// SIMD ray packets (packet_kernels.inl): the entry points of one instruction set's kernels, for brute
-// force and for every tree, reached through a table chosen once per accelerator, never per ray. The
+// SIMD packets (packet_kernels.inl; kLanes rays in SIMD lanes, not the renderer's packets of pixels):
+// the entry points of one instruction set's kernels, for brute force and for every tree, reached
+// through a table chosen once per accelerator, never per ray. The
 // kernels are templates over a tree's traits (kernel/stack_traversal.hpp) and read a tree through its
 // TreeView; the registry (src/accel) compiles them once per instruction set for the structures it lists.
 #pragma once

@@ -1,5 +1,7 @@
-// SIMD ray packets: tree and brute-force kernels that trace kLanes rays at once, one ray per lane,
-// included inside an instruction-set namespace after simd/lanes.inl (see accel/packets_<isa>.cpp). The
+// SIMD packets (Wald's ray packets): tree and brute-force kernels that trace kLanes rays at once, one
+// ray per lane (`Lanes`), included inside an instruction-set namespace after simd/lanes.inl (see
+// accel/packets_<isa>.cpp). A SIMD packet is not the renderer's P x P packet of pixels (schedule.hpp):
+// that one arrives here as a batch, a span of rays, which the kernels cut into SIMD packets. The
 // tree kernels are templates over a tree's traits (kernel/stack_traversal.hpp), like the single-ray
 // kernels: a kd-tree node is a BIH node whose two planes coincide, and the traits say where a node's
 // planes are, whether a ray can pass between them, and what a leaf's entries are.
@@ -7,26 +9,27 @@
 // Exactness. A lane computes what the single-ray kernels compute for its ray: the same conservative
 // plane tests with the same margin (kernel/traversal.hpp) and the watertight triangle test with the
 // same operations in the same order (triangle.hpp), so its hit is the brute-force hit bit for bit. A
-// packet visits a node when any of its active lanes would; lanes that would not are masked off, and
-// a lane that tests a triangle its own ray would never have reached only adds a candidate that brute
-// force tests too. So neither divergence nor the visiting order can change an answer.
+// SIMD packet visits a node when any of its active lanes would; lanes that would not are masked off,
+// and a lane that tests a triangle its own ray would never have reached only adds a candidate that
+// brute force tests too. So neither divergence nor the visiting order can change an answer.
 //
-// Large batches (a P x P packet of the renderer, P >= 8) first run an entry-point search: the whole
+// Large batches (the renderer's P x P packet, P >= 8) first run an entry-point search: the whole
 // batch is bounded by interval arithmetic (a box of origins and a box of inverse directions, when all
 // rays share their direction signs) and descends from the root while every ray in it needs only one
 // child, culling the other subtrees for the whole batch at once (Reshetov, Soupikov, Hurley,
-// "Multi-Level Ray Tracing Algorithm", SIGGRAPH 2005). Each group of kLanes rays then starts there.
+// "Multi-Level Ray Tracing Algorithm", SIGGRAPH 2005). Each SIMD packet of the batch starts there.
 //
 // No include guard: included once per instruction set.
 
-// kLanes rays, structure of arrays: what the traversal and the watertight test need per lane.
+// One SIMD packet: kLanes rays as a structure of arrays, what the traversal and the watertight test
+// need per lane.
 struct Lanes {
     F org[3], inv[3];
     I neg[3];       // the direction's sign bit per axis: the near child is the right one
     F tnear, tfar, margin;
     F sx, sy, sz;   // the watertight test's shear (WatertightRay)
     I perm;         // its axis permutation: 2 * kz + (kx and ky swapped)
-    // The same permutation as lane masks, for packets whose lanes differ: role r (0: kx, 1: ky,
+    // The same permutation as lane masks, for SIMD packets whose lanes differ: role r (0: kx, 1: ky,
     // 2: kz) is the x axis where is_x[r], the y axis where is_y[r], z elsewhere; role_org[r] is the
     // origin's coordinate on that axis.
     I is_x[3], is_y[3];
@@ -121,8 +124,9 @@ inline I clip_lanes(const Lanes& L, const Box3& box, F& tmin, F& tmax) {
 
 // The watertight test (triangle.hpp) of one triangle against the lanes of `mask`. When they share one
 // axis permutation (`perm` >= 0; the common case for coherent rays) the vertex coordinates are
-// broadcast; otherwise (`perm` < 0) each lane picks its own with masks, so a packet whose lanes point
-// different ways still needs one pass. Returns the lanes whose ray meets the triangle, with t, u, v.
+// broadcast; otherwise (`perm` < 0) each lane picks its own with masks, so a SIMD packet whose lanes
+// point different ways still needs one pass. Returns the lanes whose ray meets the triangle, with t,
+// u, v.
 inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask, F& t, F& u, F& v) {
     int axis[3] = {0, 0, 0};
     if (perm >= 0) {
@@ -316,14 +320,14 @@ inline bool incoherent(const Lanes& L) {
     return true;
 }
 
-// One packet through a tree from `start` (a node whose cell is `start_box`). Trees differ only in what
-// their traits say: their inner nodes' planes (one, or two clip planes with a gap) and their leaves
-// (indices into the scene's triangles, or ranges of the structure's reordered ones).
+// One SIMD packet through a tree from `start` (a node whose cell is `start_box`). Trees differ only in
+// what their traits say: their inner nodes' planes (one, or two clip planes with a gap) and their
+// leaves (indices into the scene's triangles, or ranges of the structure's reordered ones).
 //
 // `kHandOver`: whether a lane left alone in a subtree goes on as a single ray (trace_single_lane).
 // Worth it for incoherent lanes, which soon spread over the tree: a scalar step is cheaper than a
-// packet step for one lane. Coherent packets are traced without it: they seldom leave a lane alone
-// for long, and with the call in its loop the kernel ran coherent frames 10 to 20% slower.
+// SIMD packet's step for one lane. Coherent SIMD packets are traced without it: they seldom leave a
+// lane alone for long, and with the call in its loop the kernel ran coherent frames 10 to 20% slower.
 template <bool kHandOver, class Traits, class Query>
 inline void trace_lanes(const TreeView<Traits>& tree, const Lanes& L, const Ray* rays, Query& q, std::uint32_t start,
                         const Box3& start_box, LaneCounters c) {
@@ -439,13 +443,13 @@ inline float max_of(F x) {
 // cell contains every ray's traversal, and sets `box` to that cell; the root when the batch is not
 // coherent (invalid rays, mixed direction signs or zero direction components).
 template <class Traits>
-inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const Lanes> groups, Box3& box) {
+inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const Lanes> simd_packets, Box3& box) {
     box = tree.bounds;
     const F inf = splat(kInfinity);
     F olo[3] = {inf, inf, inf}, ohi[3] = {-inf, -inf, -inf}, ilo[3] = {inf, inf, inf}, ihi[3] = {-inf, -inf, -inf};
     F tmin_v = inf, tmax_v = -inf, margin_v = splat(0.f);
     I negative[3] = {splat_i(0), splat_i(0), splat_i(0)}, positive[3] = {splat_i(0), splat_i(0), splat_i(0)};
-    for (const Lanes& g : groups) {
+    for (const Lanes& g : simd_packets) {
         I loaded = splat_i(0);
         for (int i = 0; i < g.count; ++i) loaded[i] = -1;
         if (any(loaded & ~g.valid)) return 0;
@@ -505,31 +509,32 @@ inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const L
     }
 }
 
-// A batch through a tree, up to kGroups packets of kLanes rays at a time: loaded, an entry-point search
-// when there is more than one packet, then each packet from the entry point.
-constexpr std::size_t kGroups = 64;
+// A batch through a tree, up to kSimdPackets SIMD packets at a time: loaded, an entry-point search
+// when there is more than one, then each from the entry point.
+constexpr std::size_t kSimdPackets = 64;
 
 template <class Traits, class Query, class Out>
 void trace_batch(const TreeView<Traits>& tree, std::span<const Ray> rays, std::span<Out> results,
                  TraversalCounters* counters) {
     Out* out = results.data();
-    Lanes groups[kGroups];
-    for (std::size_t begin = 0; begin < rays.size(); begin += kGroups * kLanes) {
-        const std::size_t end = std::min(rays.size(), begin + kGroups * kLanes);
+    Lanes simd_packets[kSimdPackets];
+    for (std::size_t begin = 0; begin < rays.size(); begin += kSimdPackets * kLanes) {
+        const std::size_t end = std::min(rays.size(), begin + kSimdPackets * kLanes);
         std::size_t count = 0;
         for (std::size_t i = begin; i < end; i += kLanes)
-            groups[count++] = load_lanes(rays.data() + i, static_cast<int>(std::min<std::size_t>(kLanes, end - i)),
-                                         tree.bounds);
+            simd_packets[count++] =
+                load_lanes(rays.data() + i, static_cast<int>(std::min<std::size_t>(kLanes, end - i)), tree.bounds);
         Box3 box = tree.bounds;
-        const std::uint32_t start = count > 1 ? entry_point(tree, std::span<const Lanes>(groups, count), box) : 0;
+        const std::uint32_t start =
+            count > 1 ? entry_point(tree, std::span<const Lanes>(simd_packets, count), box) : 0;
         for (std::size_t g = 0; g < count; ++g) {
-            Query q(groups[g]);
-            const Ray* group_rays = rays.data() + begin + g * kLanes;
-            if (incoherent(groups[g]))
-                trace_incoherent_lanes(tree, groups[g], group_rays, q, start, box, LaneCounters{counters});
+            Query q(simd_packets[g]);
+            const Ray* lane_rays = rays.data() + begin + g * kLanes;
+            if (incoherent(simd_packets[g]))
+                trace_incoherent_lanes(tree, simd_packets[g], lane_rays, q, start, box, LaneCounters{counters});
             else
-                trace_lanes<false>(tree, groups[g], group_rays, q, start, box, LaneCounters{counters});
-            q.store(groups[g], out + begin + g * kLanes);
+                trace_lanes<false>(tree, simd_packets[g], lane_rays, q, start, box, LaneCounters{counters});
+            q.store(simd_packets[g], out + begin + g * kLanes);
         }
     }
     if (counters) counters->rays += rays.size();
