@@ -109,10 +109,10 @@ void print_local_store(const LocalStoreAccelerator& accel) {
     const LocalStoreStats s = accel.local_store_stats();
     std::size_t used = 0;
     for (const auto& a : accel.local_store_allocations()) used += a.bytes;
-    std::printf("local store: %zu of %zu bytes used, %s access%s, %u worker(s), %llu rays in %llu packets\n", used,
+    std::printf("local store: %zu of %zu bytes used, %s access%s, %u worker(s), %llu rays in %llu batches\n", used,
                 c.budget_bytes, to_string(c.access),
                 c.access == CacheAccess::async && !c.retouch ? " without re-touch" : "",
-                s.workers, static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.packets));
+                s.workers, static_cast<unsigned long long>(s.rays), static_cast<unsigned long long>(s.batches));
     print_cache("node cache", c.node_cache, s.node_cache);
     print_cache("triangle cache", c.triangle_cache, s.triangle_cache);
     std::printf("  modelled        %llu cycles (%.2f cycles/ray, %.1f %% waiting for transfers): %.3f ms at %.1f GHz "
@@ -143,7 +143,7 @@ nlohmann::json local_store_json(const LocalStoreAccelerator& accel) {
             {"triangle_cache", cache_json(c.triangle_cache, s.triangle_cache)},
             {"workers", s.workers},
             {"rays", s.rays},
-            {"packets", s.packets},
+            {"batches", s.batches},
             {"cycles", s.cycles},
             {"stall_cycles", s.stall_cycles},
             {"busiest_worker_cycles", s.frame_cycles},

@@ -58,10 +58,10 @@ inline constexpr std::size_t kDirectoryBytesPerLine = 8;
 
 struct LocalStoreStats {
     CacheStats node_cache, triangle_cache;
-    std::uint64_t rays = 0;          // rays traced through the model (primary and shadow)
+    std::uint64_t rays = 0;          // rays traced through the model (primary and secondary)
     // Batches loaded into a local store (WorkerStore::load_batch); a renderer's packet is two, its
     // primary rays and its shadow rays (one when none of its primary rays hit).
-    std::uint64_t packets = 0;
+    std::uint64_t batches = 0;
     std::uint64_t cycles = 0;        // modelled cycles, summed over the workers
     std::uint64_t stall_cycles = 0;  // of which the workers waited for transfers
     std::uint64_t frame_cycles = 0;  // the busiest worker's cycles: the run's modelled duration

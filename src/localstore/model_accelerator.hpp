@@ -124,7 +124,7 @@ public:
             s.node_cache += w.node_cache.stats;
             s.triangle_cache += w.triangle_cache.stats;
             s.rays += w.rays();
-            s.packets += w.batches();
+            s.batches += w.batches();
             s.cycles += w.cycles();
             s.stall_cycles += w.stall_cycles();
             s.frame_cycles = std::max(s.frame_cycles, w.cycles());
