@@ -15,13 +15,13 @@ namespace cellrt {
 namespace {
 
 // Every exact structure path: KIND:TRAVERSAL for single rays, KIND+SIMD for the packet kernels of
-// each instruction set this machine runs; and the BIH built with the SAH, by both.
+// each instruction set this machine runs (for the wide BVH, its single-ray kernels of that set); and
+// the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
-                                    "bih:branched@split=sah", "bih+auto@split=sah", "bvh+portable"};
+                                    "bih:branched@split=sah", "bih+auto@split=sah"};
     for (detail::Isa isa : detail::available_isas())
-        for (const char* kind : {"kd", "bih"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
-    if (detail::available_isas().back() != detail::Isa::portable) out.push_back("bvh+auto");
+        for (const char* kind : {"kd", "bih", "bvh"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;
 }
 const std::vector<std::string> kConfigs = exact_configs();

@@ -13,9 +13,9 @@ const std::vector<std::string> kTraversals{"wide"};
 
 // The kernels for `simd` (see bvh_accel.hpp), with the name of their instruction set.
 std::pair<const detail::BvhKernels*, const char*> kernels_for(const std::string& simd) {
-    if (simd == "avx512") throw Error("the BVH's nodes are eight wide: its kernels run portable or avx2, not avx512");
     const detail::Isa isa = detail::parse_isa(simd == "off" ? "auto" : simd);
-    if (isa == detail::Isa::avx2 || isa == detail::Isa::avx512) return {&detail::bvh_kernels_avx2(), "avx2"};
+    if (isa == detail::Isa::avx512) return {&detail::bvh_kernels_avx512(), "avx512"};
+    if (isa == detail::Isa::avx2) return {&detail::bvh_kernels_avx2(), "avx2"};
     return {&detail::bvh_kernels_portable(), "portable"};
 }
 

@@ -4,8 +4,8 @@
 //
 // Build parameters: bvh_params(). The build runs on one thread (AccelConfig::threads is not used).
 // Traversals: "wide" (the one). AccelConfig::simd picks the kernels' instruction set: "off" and
-// "auto" the best this processor runs, "portable" or "sse" the generic ones, "avx2" AVX2; "avx512"
-// is refused (the nodes are eight wide).
+// "auto" the best this processor runs, "portable" or "sse" the generic ones, "avx2" or "avx512"
+// those (eight lanes in both; AVX-512 adds registers).
 #pragma once
 
 #include <memory>

@@ -2,6 +2,7 @@
 // before it opens its target region and namespace, and the table of kernels each one offers.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -21,8 +22,10 @@ struct BvhKernels {
     void (*any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
 };
 
-// The same kernels with the compiler's generic vectors and no target (any processor), and for AVX2.
+// The same kernels with the compiler's generic vectors and no target (any processor), for AVX2, and
+// for AVX-512 (eight lanes still, with its 32 registers).
 const BvhKernels& bvh_kernels_portable();
 const BvhKernels& bvh_kernels_avx2();
+const BvhKernels& bvh_kernels_avx512();
 
 }  // namespace cellrt::detail

@@ -112,6 +112,35 @@ bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, 
     }
 }
 
+// The children that are leaves, as a bit mask (the leaf bit is the sign bit of a child word).
+inline unsigned leaf_lanes(const BvhNode& node) {
+    return bits(reinterpret_cast<I>(load_u(node.child)) < 0) & bits(reinterpret_cast<I>(load_u(node.child)) != -1);
+}
+
+// The lanes of a bit mask, as a lane mask.
+inline I met_mask(unsigned met) {
+    return (splat_i(static_cast<std::int32_t>(met)) & I{1, 2, 4, 8, 16, 32, 64, 128}) != 0;
+}
+
+// The smallest of eight lanes.
+inline float horizontal_min(F x) {
+    F y = __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3);
+    x = select(y < x, y, x);
+    y = __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5);
+    x = select(y < x, y, x);
+    y = __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6);
+    x = select(y < x, y, x);
+    return x[0];
+}
+
+// Starts loading a child that waits on the stack: on incoherent rays its lines are far from the
+// core, and the nearer subtree is traced meanwhile.
+inline void prefetch(const BvhNode* nodes, const BvhLeaf* leaves, std::uint32_t word) {
+    const char* p = BvhNode::is_leaf(word) ? reinterpret_cast<const char*>(&leaves[BvhNode::leaf_index(word)])
+                                           : reinterpret_cast<const char*>(&nodes[word]);
+    for (int line = 0; line < 5; ++line) __builtin_prefetch(p + 64 * line);
+}
+
 // A child waiting on the stack: its word and the distance at which the ray enters its box.
 struct BvhStackEntry {
     std::uint32_t word;
@@ -136,17 +165,32 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
             const BvhNode& node = nodes[word];
             F entry;
             unsigned met = meet_children(node, box_ray, q.cull_t(), entry);
-            if (met) {
-                // Push the children met, farthest first, and go on with the nearest.
-                const int first = sp;
-                for (; met; met &= met - 1) {
-                    const int k = __builtin_ctz(met);
-                    const BvhStackEntry e{node.child[k], entry[k]};
-                    int j = sp++;
-                    for (; j > first && stack[j - 1].entry < e.entry; --j) stack[j] = stack[j - 1];
-                    stack[j] = e;
+            if constexpr (Query::kAnyHit) {
+                // Any hit ends the query, and leaves end it sooner than subtrees: test the leaves
+                // met at once, and go on only into the inner children.
+                for (unsigned leaves_met = met & leaf_lanes(node); leaves_met; leaves_met &= leaves_met - 1) {
+                    const std::uint32_t w = node.child[__builtin_ctz(leaves_met)];
+                    if (test_leaf(leaves[BvhNode::leaf_index(w)], BvhNode::leaf_count(w), r, q, c)) return true;
                 }
-                word = stack[--sp].word;
+                met &= ~leaf_lanes(node);
+            }
+            if (met) {
+                // One child met (the common case deep in the tree): go there. Several: push them,
+                // farthest first, and go on with the nearest.
+                if ((met & (met - 1)) == 0) {
+                    word = node.child[__builtin_ctz(met)];
+                    continue;
+                }
+                // The nearest child goes first; the others wait unsorted (sorting them costs more on
+                // incoherent rays than the order saves, and a popped child past the answer is skipped).
+                const F masked = select(met_mask(met), entry, splat(kInfinity));
+                const unsigned nearest = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
+                word = node.child[nearest];
+                for (met &= ~(1u << nearest); met; met &= met - 1) {
+                    const int k = __builtin_ctz(met);
+                    stack[sp++] = {node.child[k], entry[k]};
+                    prefetch(nodes, leaves, node.child[k]);
+                }
                 continue;
             }
         }
@@ -158,21 +202,28 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
     }
 }
 
-// The batch entry points: one kernel per query, over a batch.
+// The answers for a tree without triangles: nothing is hit.
+template <class Answer>
+void miss_all(std::span<const Ray> rays, std::span<Answer> out, TraversalCounters* counters) {
+    std::fill(out.begin(), out.end(), Answer{});
+    if (counters) counters->rays += rays.size();
+}
+
+// The batch entry points: one kernel per query, over a batch. The root's box test is the scene box
+// test, so rays are not clipped to the scene first.
 inline void closest_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
                           TraversalCounters* counters) {
+    if (tree.nodes.empty()) return miss_all(rays, hits, counters);
     closest_hits(tree.bounds, rays, hits, counters, [&](const TraversalRay& r, ClosestHit& q, auto& count) {
-        float tmin, tmax;
-        if (r.clip(tree.bounds, tmin, tmax)) traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
-        return false;
+        return traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
     });
 }
 
 inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                       TraversalCounters* counters) {
+    if (tree.nodes.empty()) return miss_all(rays, occluded, counters);
     any_hits(tree.bounds, rays, occluded, counters, [&](const TraversalRay& r, AnyHit& q, auto& count) {
-        float tmin, tmax;
-        return r.clip(tree.bounds, tmin, tmax) && traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
+        return traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
     });
 }
 
