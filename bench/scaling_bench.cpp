@@ -1,14 +1,15 @@
 // The study's scaling measurement (its Tables 5-1 and 5-2), with Embree alongside: seconds per frame
-// (512 x 512, primary + one shadow ray per hit) for 1..N workers, per scene, structure, dispatch mode
-// and packet size. Every point is a warm-up frame and the median of --repeats frames, each timed
-// frame the second of two drawn back to back, the worker counts interleaved round by round (the
-// efficiency and the packet time ratio are medians of each round's own ratios); every table
-// shows cellrt's time and its rays per second as a ratio to Embree's with the same workers, dispatch
-// and packet size, measured in the same run. Where the efficiency goes is split: the share of the
-// workers' time spent tracing and what the schedule took of the rest (waking the workers, between
-// packets, waiting for the last one at the end), and how much longer the same packets took with N
-// workers than with one (shared caches and memory, the clock). Writes Markdown tables to stdout and
-// every point as JSON and CSV; bench/plot_scaling.py draws the curves.
+// (512 x 512, primary rays and those their --shading casts, by default the study's one shadow ray per
+// hit) for 1..N workers, per scene, structure, dispatch mode and packet size. Every point is a warm-up
+// frame and the median of --repeats frames, each timed frame the second of two drawn back to back, the
+// worker counts interleaved round by round (the efficiency and the packet time ratio are medians of
+// each round's own ratios); every table shows cellrt's time and its rays per second as a ratio to
+// Embree's with the same workers, dispatch and packet size, measured in the same run. Where the
+// efficiency goes is split: the share of the workers' time spent tracing and what the schedule took of
+// the rest (waking the workers, between packets, waiting for the last one at the end), and how much
+// longer the same packets took with N workers than with one (shared caches and memory, the clock).
+// Writes Markdown tables to stdout and every point as JSON and CSV; bench/plot_scaling.py draws the
+// curves.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -26,6 +27,7 @@
 #include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
+#include "cellrt/workload.hpp"
 
 namespace {
 
@@ -64,13 +66,14 @@ struct Options {
     std::vector<unsigned> workers;  // sorted, without repeats
     int repeats = 3;
     std::string size = "512x512";
+    ShadingOptions shading;  // every frame's, the yardstick's too
     std::string csv_path, json_path;
     int idle_spin = static_cast<int>(kDefaultIdleSpin.count());
     bool pin = false;
 };
 
 // Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
-// option), as CLI11_PARSE would.
+// option), as CLI11_PARSE would. Throws cellrt::Error for a bad --shading.
 std::optional<int> parse_options(int argc, char** argv, Options& o) {
     CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size, Embree alongside"};
     app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
@@ -96,6 +99,14 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         ->capture_default_str()
         ->check(CLI::Range(1, 100));
     app.add_option("--size", o.size, "Image size WxH (the study's: 512x512)")->capture_default_str();
+    std::string shading = to_string(o.shading.shading);
+    app.add_option("--shading", shading,
+                   "direct: one shadow ray per hit (the study's); ao: ambient occlusion; diffuse: one bounce lit "
+                   "by the light")
+        ->capture_default_str();
+    auto* ao_samples = app.add_option("--ao-samples", o.shading.ao_samples, "AO rays per hit, with --shading ao")
+                           ->capture_default_str()
+                           ->check(CLI::Range(1, kMaxAoSamples));
     app.add_option("--idle-spin-us", o.idle_spin, "Microseconds the workers poll for the next frame before sleeping")
         ->capture_default_str()
         ->check(CLI::Range(0, 1000000));
@@ -107,6 +118,13 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
+    try {
+        o.shading.shading = parse_shading(shading);
+    } catch (const Error& e) {
+        throw Error("--shading: " + std::string(e.what()));  // the library names the value, the user typed the option
+    }
+    // Another shading casts no AO rays: the rows would record samples that were never taken.
+    if (ao_samples->count() > 0 && o.shading.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
     if (o.workers.empty())
         for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) o.workers.push_back(w);
     std::sort(o.workers.begin(), o.workers.end());  // efficiencies are against the fewest
@@ -215,6 +233,7 @@ Study measure(const Options& o) {
                     ro.dispatch = parse_dispatch(d);
                     ro.idle_spin = std::chrono::microseconds(o.idle_spin);
                     ro.pin = o.pin;
+                    ro.shading = o.shading;
                     add_points(timed_frames(scene, *accel, ro, o), scene.name, cfg_text, d, p, o, study.points);
                 }
         }
@@ -230,13 +249,20 @@ const Point* find(const std::vector<Point>& points, const std::string& scene, co
     return nullptr;
 }
 
+// The shading as the tables' headings name it.
+std::string shading_label(const ShadingOptions& s) {
+    const std::string name = std::string(to_string(s.shading)) + " shading";
+    return s.shading == Shading::ao ? name + ", " + std::to_string(s.ao_samples) + " AO rays per hit" : name;
+}
+
 // Shaped like the study's: rows scenes, columns workers, seconds per frame with cellrt's rays/s over
 // the yardstick's, and the parallel efficiency at the most workers.
 void print_seconds_table(const Study& study, const Options& o, const std::string& yardstick,
                          const std::string& config, const std::string& d, int p) {
     const unsigned most = o.workers.back();
-    std::printf("\n### %s, %s dispatch, %dx%d packets: seconds per frame (rays/s ÷ %s)\n\n| scene |", config.c_str(),
-                d.c_str(), p, p, yardstick.empty() ? "Embree" : yardstick.c_str());
+    std::printf("\n### %s, %s dispatch, %dx%d packets, %s: seconds per frame (rays/s ÷ %s)\n\n| scene |",
+                config.c_str(), d.c_str(), p, p, shading_label(o.shading).c_str(),
+                yardstick.empty() ? "Embree" : yardstick.c_str());
     for (unsigned w : o.workers) std::printf(" %u |", w);
     std::printf(" efficiency at %u |\n|---|", most);
     for (std::size_t i = 0; i <= o.workers.size(); ++i) std::printf("---|");
@@ -275,16 +301,19 @@ void print_time_shares(const Study& study, const Options& o, const std::string& 
     }
 }
 
-// Every point, with the yardstick's seconds for the same scene, dispatch, packet size and workers
-// where it was measured.
-nlohmann::json points_json(const std::vector<Point>& points, const std::string& yardstick) {
+// Every point, with the run's shading (ao_samples only for ao) and the yardstick's seconds for the same
+// scene, dispatch, packet size and workers where it was measured.
+nlohmann::json points_json(const std::vector<Point>& points, const std::string& yardstick,
+                           const ShadingOptions& shading) {
     nlohmann::json out = nlohmann::json::array();
     for (const Point& pt : points) {
         nlohmann::json j{{"scene", pt.scene},   {"config", pt.config},   {"dispatch", pt.dispatch},
-                         {"packet", pt.packet}, {"workers", pt.workers}, {"seconds", pt.seconds},
+                         {"packet", pt.packet}, {"shading", to_string(shading.shading)},
+                         {"workers", pt.workers}, {"seconds", pt.seconds},
                          {"busy_seconds", pt.busy_seconds}, {"started_seconds", pt.started_seconds},
                          {"waiting_seconds", pt.waiting_seconds}, {"efficiency", pt.efficiency},
                          {"packet_time_ratio", pt.packet_time_ratio}, {"rays", pt.rays}};
+        if (shading.shading == Shading::ao) j["ao_samples"] = shading.ao_samples;
         if (const Point* y =
                 yardstick.empty() ? nullptr : find(points, pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;
@@ -293,27 +322,29 @@ nlohmann::json points_json(const std::vector<Point>& points, const std::string& 
     return out;
 }
 
-// The JSON rows as CSV, a column each; embree_seconds is empty where there was no yardstick.
+// The JSON rows as CSV, a column each; ao_samples and embree_seconds are empty where a row lacks them.
 void write_csv(const std::string& path, const nlohmann::json& rows) {
     std::ofstream csv(path);
-    csv << "scene,config,dispatch,packet,workers,seconds,busy_seconds,started_seconds,waiting_seconds,efficiency,"
-           "packet_time_ratio,rays,embree_seconds\n";
-    for (const auto& j : rows)
+    csv << "scene,config,dispatch,packet,shading,ao_samples,workers,seconds,busy_seconds,started_seconds,"
+           "waiting_seconds,efficiency,packet_time_ratio,rays,embree_seconds\n";
+    for (const auto& j : rows) {
+        const auto optional = [&j](const char* key) { return j.contains(key) ? j[key].dump() : std::string(); };
         csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
-            << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["workers"] << ',' << j["seconds"]
-            << ',' << j["busy_seconds"] << ',' << j["started_seconds"] << ',' << j["waiting_seconds"] << ','
-            << j["efficiency"] << ',' << j["packet_time_ratio"] << ',' << j["rays"] << ','
-            << (j.contains("embree_seconds") ? j["embree_seconds"].dump() : "") << '\n';
+            << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["shading"].get<std::string>() << ','
+            << optional("ao_samples") << ',' << j["workers"] << ',' << j["seconds"] << ',' << j["busy_seconds"] << ','
+            << j["started_seconds"] << ',' << j["waiting_seconds"] << ',' << j["efficiency"] << ','
+            << j["packet_time_ratio"] << ',' << j["rays"] << ',' << optional("embree_seconds") << '\n';
+    }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
     Options o;
-    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
     std::string yardstick;
     Study study;
     try {
+        if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
         yardstick = yardstick_of(o.configs);  // parses the configurations: a bad one is the user's error
         study = measure(o);
     } catch (const Error& e) {
@@ -327,7 +358,7 @@ int main(int argc, char** argv) {
                 print_seconds_table(study, o, yardstick, config, d, p);
                 print_time_shares(study, o, config, d, p);
             }
-    const nlohmann::json out = points_json(study.points, yardstick);
+    const nlohmann::json out = points_json(study.points, yardstick, o.shading);
     if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
     if (!o.csv_path.empty()) write_csv(o.csv_path, out);
     return 0;

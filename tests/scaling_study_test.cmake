@@ -1,16 +1,17 @@
 # The scaling study end to end, on a small scene: cellrt_scaling's tables and JSON for both dispatch
-# modes at 1 and 2 workers, then bench/scaling_tables.py and bench/plot_scaling.py on that JSON, as
+# modes at 1 and 2 workers (AO shading, which every row records), then bench/scaling_tables.py and bench/plot_scaling.py on that JSON, as
 # docs/SCALING.md runs them. Arguments: SCALING (the program), PYTHON, SOURCE, WORK.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(
   COMMAND ${SCALING} --scenes builtin:city?tris=3000 --configs kd+auto bih:branched --dispatch pull mailbox
-          --packets 8 --workers 1 2 --repeats 1 --size 40x24 --json ${WORK}/scaling.json --csv ${WORK}/scaling.csv
+          --packets 8 --workers 1 2 --repeats 1 --size 40x24 --shading ao --ao-samples 2
+          --json ${WORK}/scaling.json --csv ${WORK}/scaling.csv
   OUTPUT_VARIABLE tables ERROR_VARIABLE log RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "cellrt_scaling failed (${rc}): ${log}")
 endif()
-foreach(expected "### kd+auto, mailbox dispatch, 8x8 packets" "Where the 2 workers' time went" "| city |")
+foreach(expected "### kd+auto, mailbox dispatch, 8x8 packets, ao shading, 2 AO rays per hit" "Where the 2 workers' time went" "| city |")
   string(FIND "${tables}" "${expected}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "cellrt_scaling's tables lack '${expected}':\n${tables}")
@@ -33,6 +34,11 @@ foreach(i RANGE ${last})
   string(JSON efficiency GET "${json}" ${i} efficiency)
   string(JSON packet_time GET "${json}" ${i} packet_time_ratio)
   string(JSON workers GET "${json}" ${i} workers)
+  string(JSON shading GET "${json}" ${i} shading)
+  string(JSON ao_samples GET "${json}" ${i} ao_samples)
+  if(NOT shading STREQUAL "ao" OR NOT ao_samples EQUAL 2)
+    message(FATAL_ERROR "point ${i} records shading '${shading}' with ${ao_samples} AO samples, not ao with 2")
+  endif()
   if(NOT seconds GREATER 0 OR NOT busy GREATER 0 OR started LESS 0 OR waiting LESS 0 OR NOT rays GREATER 960
      OR NOT efficiency GREATER 0 OR NOT packet_time GREATER 0)
     message(FATAL_ERROR "point ${i} is implausible: ${seconds} s, busy ${busy}, started ${started}, waiting ${waiting}, "
@@ -43,6 +49,20 @@ foreach(i RANGE ${last})
     message(FATAL_ERROR "point ${i} (1 worker) has efficiency ${efficiency} and packet time ratio ${packet_time}, not 1")
   endif()
 endforeach()
+
+file(STRINGS ${WORK}/scaling.csv csv)
+list(GET csv 0 header)
+list(GET csv 1 row)
+if(NOT header MATCHES "^scene,config,dispatch,packet,shading,ao_samples,workers," OR NOT row MATCHES ",8,ao,2,")
+  message(FATAL_ERROR "the CSV lacks the shading: ${header}\n${row}")
+endif()
+
+# A bad shading is the user's error, under the option's name, before any frame.
+execute_process(COMMAND ${SCALING} --shading glossy ERROR_VARIABLE log RESULT_VARIABLE rc)
+string(FIND "${log}" "cellrt_scaling: error: --shading: " at)
+if(NOT rc EQUAL 1 OR at EQUAL -1)
+  message(FATAL_ERROR "cellrt_scaling --shading glossy: ${rc}, ${log}")
+endif()
 
 execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/scaling_tables.py ${WORK}/scaling.json
                 OUTPUT_VARIABLE table ERROR_VARIABLE log RESULT_VARIABLE rc)
