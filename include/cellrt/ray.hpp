@@ -41,7 +41,7 @@ inline bool closer(float t, std::uint32_t prim, const Hit& best) {
     return t < best.t || (t == best.t && prim < best.prim);
 }
 
-inline bool is_valid(const Ray& r) {
+[[gnu::always_inline]] inline bool is_valid(const Ray& r) {
     return is_finite(r.org) && is_finite(r.dir) && !(r.dir == Vec3{}) && !(r.tnear > r.tfar) &&
            r.tnear == r.tnear && r.tfar == r.tfar;
 }

@@ -54,8 +54,10 @@ struct WatertightRay {
 
 // Core of the test: on success writes t = T/det and the barycentrics, without any range check.
 // Returns false when the ray misses the triangle's plane region or the triangle is degenerate
-// (det == 0: zero area, or seen edge-on).
-inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+// (det == 0: zero area, or seen edge-on). Always inlined, as the per-ray set-up of the traversals
+// (kernel/traversal.hpp): a unit that instantiates many kernels exhausts GCC's inlining budget,
+// and an out-of-line call costs a kernel up to a tenth of its instructions (docs/BENCHMARKS.md).
+[[gnu::always_inline]] inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     // The vertices' coordinates in ray order (x, y, z of v0, v1, v2 as nine floats, read by index).
     const auto c9 = std::bit_cast<std::array<float, 9>>(tri);
     const float ox = r.org[r.kx], oy = r.org[r.ky], oz = r.org[r.kz];

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "accel/local_store_registry.hpp"
+#include "accel/packet_table.hpp"
 #include "accel/structures.hpp"
 #include "accel/tree_accelerator.hpp"
 #include "accel/brute_force_listing.hpp"
@@ -43,7 +44,11 @@ std::vector<Entry> make_entries() {
                            },
                            &S::param_table(), detail::names_of(S::kTraversals), &detail::make_model<S>});
     });
-    entries.push_back({"bvh", &make_bvh, &bvh_params(), bvh_traversals()});
+    entries.push_back({"bvh",
+                       [](std::span<const Triangle> triangles, const AccelConfig& config) {
+                           return make_bvh(triangles, config, detail::bvh_kernels_for(config));
+                       },
+                       &bvh_params(), bvh_traversals()});
 #ifdef CELLRT_HAVE_EMBREE
     entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
 #endif

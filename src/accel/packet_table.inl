@@ -1,5 +1,5 @@
 // Included inside an instruction set's region and namespace after packet/packet_kernels.inl (see
-// packets_<isa>.cpp): that set's table for the listed structures.
+// kernels_<isa>.cpp): that set's table for the listed structures.
 // No include guard: included once per instruction set.
 template <class... S>
 PacketKernels table_for(StructureList<S...>) {

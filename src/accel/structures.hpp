@@ -1,6 +1,6 @@
 // The trees this binary offers: the one list. Adding a structure is one folder with its descriptor
 // (see kdtree/kd_structure.hpp) and one entry in TreeStructures; the registry (accel.cpp), the SIMD
-// packets (packets_<isa>.cpp) and the local-store model (local_store_registry.cpp) are instantiated
+// packets (kernels_<isa>.cpp) and the local-store model (local_store_registry.cpp) are instantiated
 // for every entry.
 #pragma once
 

@@ -1,29 +1,19 @@
 #include "bvh/bvh_accel.hpp"
 
-#include "bvh/bvh_isa.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
 #include "kernel/param_reader.hpp"
-#include "simd/isa.hpp"
 
 namespace cellrt {
 namespace {
 
 const std::vector<std::string> kTraversals{"wide"};
 
-// The kernels for `simd` (see bvh_accel.hpp), with the name of their instruction set.
-std::pair<const detail::BvhKernels*, const char*> kernels_for(const std::string& simd) {
-    const detail::Isa isa = detail::parse_isa(simd == "off" ? "auto" : simd);
-    if (isa == detail::Isa::avx512) return {&detail::bvh_kernels_avx512(), "avx512"};
-    if (isa == detail::Isa::avx2) return {&detail::bvh_kernels_avx2(), "avx2"};
-    return {&detail::bvh_kernels_portable(), "portable"};
-}
-
 class BvhAccelerator final : public Accelerator {
 public:
     BvhAccelerator(std::span<const Triangle> triangles, const detail::BvhBuildOptions& options,
-                   const detail::BvhKernels& kernels, const char* isa)
-        : options_(options), kernels_(kernels), isa_(isa), triangle_count_(triangles.size()) {
+                   const detail::BvhKernels& kernels)
+        : options_(options), kernels_(kernels), triangle_count_(triangles.size()) {
         const Timer timer;
         tree_ = detail::build_bvh(triangles, options);
         build_seconds_ = timer.seconds();
@@ -57,14 +47,13 @@ public:
                       {"max_leaf", std::to_string(options_.max_leaf)},
                       {"traversal_cost", param_number(options_.traversal_cost)},
                       {"intersection_cost", param_number(options_.intersection_cost)},
-                      {"isa", isa_}};
+                      {"isa", kernels_.isa}};
         return s;
     }
 
 private:
     detail::BvhBuildOptions options_;
     const detail::BvhKernels& kernels_;
-    const char* isa_;
     std::size_t triangle_count_;
     detail::BvhTree tree_;
     double build_seconds_ = 0.0;
@@ -86,7 +75,8 @@ const ParamTable& bvh_params() {
 
 const std::vector<std::string>& bvh_traversals() { return kTraversals; }
 
-std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config) {
+std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config,
+                                      const detail::BvhKernels& kernels) {
     detail::ParamReader params(bvh_params(), config, "bvh");
     detail::BvhBuildOptions options;
     options.bins = params.integer("bins");
@@ -95,8 +85,7 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.intersection_cost = params.number("intersection_cost");
     params.finish();
     detail::choose_traversal(kTraversals, config.traversal, "bvh");
-    const auto [kernels, isa] = kernels_for(config.simd);
-    return std::make_unique<BvhAccelerator>(triangles, options, *kernels, isa);
+    return std::make_unique<BvhAccelerator>(triangles, options, kernels);
 }
 
 }  // namespace cellrt

@@ -3,9 +3,8 @@
 // a node's children and a leaf's triangles. Exact under the hit rule, like the trees.
 //
 // Build parameters: bvh_params(). The build runs on one thread (AccelConfig::threads is not used).
-// Traversals: "wide" (the one). AccelConfig::simd picks the kernels' instruction set: "off" and
-// "auto" the best this processor runs, "portable" or "sse" the generic ones, "avx2" or "avx512"
-// those (eight lanes in both; AVX-512 adds registers).
+// Traversals: "wide" (the one). The kernels come from the registry, compiled for the instruction set
+// AccelConfig::simd names (registry: bvh_kernels_for; eight lanes in every set).
 #pragma once
 
 #include <memory>
@@ -13,12 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "bvh/bvh_kernels.hpp"
 #include "cellrt/accelerator.hpp"
 #include "cellrt/params.hpp"
 
 namespace cellrt {
 
-std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config);
+std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config,
+                                      const detail::BvhKernels& kernels);
 const ParamTable& bvh_params();
 const std::vector<std::string>& bvh_traversals();
 

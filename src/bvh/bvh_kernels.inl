@@ -1,6 +1,6 @@
 // The wide BVH's single-ray kernels, included by each instruction set's translation unit
-// (bvh_<isa>.cpp) inside its target region and namespace, after simd/lanes.inl with kLanes = 8: one
-// lane per child of a node and per triangle of a leaf.
+// (accel/kernels_<isa>.cpp) inside its target region, in a namespace of their own after
+// simd/lanes.inl with kLanes = 8: one lane per child of a node and per triangle of a leaf.
 //
 // A node: the ray's slab distances to the eight child boxes, widened by the ray's margin
 // (kernel/traversal.hpp) exactly as the scalar clip() widens the scene box, so that a box is missed
@@ -10,7 +10,9 @@
 // operations and order, so each lane's t, u and v are the scalar test's bits; the hit rule then picks
 // among the lanes. Hence the kernels return exactly the hits of brute force.
 //
-// No include guard: every instruction set includes it once, in its own namespace and target.
+// No include guard: every instruction set's unit includes it once, in a namespace of its own.
+
+static_assert(kLanes == kBvhWidth, "one lane per child and per triangle");
 
 inline F load(const float* p) {
     F x;
@@ -227,7 +229,7 @@ inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<
     });
 }
 
-inline const BvhKernels& kernels() {
-    static const BvhKernels k{&closest_batch, &any_batch};
+inline const BvhKernels& bvh_kernels(const char* isa) {
+    static const BvhKernels k{&closest_batch, &any_batch, isa};
     return k;
 }

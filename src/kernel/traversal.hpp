@@ -38,7 +38,8 @@ struct TraversalRay {
     float margin;
     WatertightRay watertight;
 
-    TraversalRay(const Ray& r, const Box3& scene_box)
+    // Always inlined, with clip() and the triangle test (triangle.hpp): see intersect_unbounded.
+    [[gnu::always_inline]] TraversalRay(const Ray& r, const Box3& scene_box)
         : org(r.org), dir(r.dir), tnear(r.tnear), tfar(r.tfar), watertight(r) {
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.f / dir[a];
@@ -53,7 +54,7 @@ struct TraversalRay {
     // The ray's interval [tnear, tfar] clipped to `box`, both widened by the margin. False when empty.
     // A slab the ray lies in exactly (origin on its face, zero direction on its axis) gives NaN and
     // does not cut the interval.
-    bool clip(const Box3& box, float& tmin, float& tmax) const {
+    [[gnu::always_inline]] bool clip(const Box3& box, float& tmin, float& tmax) const {
         tmin = tnear - margin;
         tmax = tfar + margin;
         for (int a = 0; a < 3; ++a) {

@@ -1,6 +1,6 @@
 // SIMD packets (Wald's ray packets): tree and brute-force kernels that trace kLanes rays at once, one
 // ray per lane (`Lanes`), included inside an instruction-set namespace after simd/lanes.inl (see
-// accel/packets_<isa>.cpp). A SIMD packet is not the renderer's P x P packet of pixels (schedule.hpp):
+// accel/kernels_<isa>.cpp). A SIMD packet is not the renderer's P x P packet of pixels (schedule.hpp):
 // that one arrives here as a batch, a span of rays, which the kernels cut into SIMD packets. The
 // tree kernels are templates over a tree's traits (kernel/stack_traversal.hpp), like the single-ray
 // kernels: a kd-tree node is a BIH node whose two planes coincide, and the traits say where a node's

@@ -1,6 +1,6 @@
 // Instruction sets the SIMD kernels are built for, and which one runs. Each set's kernels are
 // compiled in a translation unit of their own under `#pragma GCC target` and a namespace of their
-// own (accel/packets_<isa>.cpp), so the rest of the program stays baseline code and a machine without, say,
+// own (accel/kernels_<isa>.cpp), so the rest of the program stays baseline code and a machine without, say,
 // AVX-512 never executes an AVX-512 instruction. `portable` is the same code with the compiler's
 // generic vectors and no target: it builds and runs anywhere.
 #pragma once

@@ -1,9 +1,9 @@
-// SIMD lanes for the packet kernels: GCC/Clang generic vectors of kLanes floats, included inside an
-// instruction-set namespace (see isa.hpp) that defines kLanes. Arithmetic on these types is IEEE
-// single precision lane by lane with no contraction (-ffp-contract=off), so a lane computes the very
-// bits the scalar code computes from the same operands in the same order.
+// SIMD lanes for the packet kernels and the wide BVH: GCC/Clang generic vectors of kLanes floats,
+// included inside an instruction-set namespace (see isa.hpp) that defines kLanes. Arithmetic on
+// these types is IEEE single precision lane by lane with no contraction (-ffp-contract=off), so a
+// lane computes the very bits the scalar code computes from the same operands in the same order.
 //
-// No include guard: every instruction set includes it once, in its own namespace and target.
+// No include guard: included once per namespace of lanes, in its instruction set's target.
 
 typedef float F __attribute__((vector_size(4 * kLanes)));
 typedef std::int32_t I __attribute__((vector_size(4 * kLanes)));  // lane masks: -1 true, 0 false
@@ -15,36 +15,44 @@ inline U splat_u(std::uint32_t x) { return U{} + x; }
 inline I mask_of(bool b) { return splat_i(b ? -1 : 0); }
 
 // Bit i set when lane i of the mask is true: one instruction where the set has one (the including
-// file defines CELLRT_SIMD_SSE, _AVX2 or _AVX512 when it compiles for that set).
-inline unsigned bits(I m) {
+// file defines CELLRT_SIMD_SSE, _AVX2 or _AVX512 when it compiles for that set). By the vector's
+// size, so that a unit can hold lanes of two widths (the packets' and the wide BVH's eight).
+template <class V>
+inline unsigned lane_bits(V m) {
 #if defined(CELLRT_SIMD_AVX512)
-    return _mm512_movepi32_mask(reinterpret_cast<__m512i>(m));
-#elif defined(CELLRT_SIMD_AVX2)
-    return static_cast<unsigned>(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
-#elif defined(CELLRT_SIMD_SSE)
-    return static_cast<unsigned>(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
-#else
-    unsigned out = 0;
-    for (int i = 0; i < kLanes; ++i) out |= (m[i] < 0 ? 1u : 0u) << i;
-    return out;
+    if constexpr (sizeof(V) == 64) return _mm512_movepi32_mask(reinterpret_cast<__m512i>(m));
 #endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2)
+    if constexpr (sizeof(V) == 32) return static_cast<unsigned>(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2) || defined(CELLRT_SIMD_SSE)
+    if constexpr (sizeof(V) == 16) return static_cast<unsigned>(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+#endif
+    unsigned out = 0;
+    for (int i = 0; i < static_cast<int>(sizeof(V) / 4); ++i) out |= (m[i] < 0 ? 1u : 0u) << i;
+    return out;
 }
+inline unsigned bits(I m) { return lane_bits(m); }
 inline bool any(I m) { return bits(m) != 0; }
 
 // IEEE square root lane by lane (correctly rounded, so equal to std::sqrt).
-inline F sqrt_lanes(F x) {
+template <class V>
+inline V lane_sqrt(V x) {
 #if defined(CELLRT_SIMD_AVX512)
     // The masked form: GCC 12's unmasked one reads an uninitialised vector (harmlessly) and warns.
-    return reinterpret_cast<F>(_mm512_mask_sqrt_ps(reinterpret_cast<__m512>(x), 0xffff, reinterpret_cast<__m512>(x)));
-#elif defined(CELLRT_SIMD_AVX2)
-    return reinterpret_cast<F>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
-#elif defined(CELLRT_SIMD_SSE)
-    return reinterpret_cast<F>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
-#else
-    for (int i = 0; i < kLanes; ++i) x[i] = std::sqrt(x[i]);
-    return x;
+    if constexpr (sizeof(V) == 64)
+        return reinterpret_cast<V>(_mm512_mask_sqrt_ps(reinterpret_cast<__m512>(x), 0xffff, reinterpret_cast<__m512>(x)));
 #endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2)
+    if constexpr (sizeof(V) == 32) return reinterpret_cast<V>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2) || defined(CELLRT_SIMD_SSE)
+    if constexpr (sizeof(V) == 16) return reinterpret_cast<V>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
+#endif
+    for (int i = 0; i < static_cast<int>(sizeof(V) / 4); ++i) x[i] = std::sqrt(x[i]);
+    return x;
 }
+inline F sqrt_lanes(F x) { return lane_sqrt(x); }
 
 // Lane-wise a ? b : c, for floats and integers.
 inline F select(I m, F a, F b) { return m ? a : b; }

@@ -1,0 +1,24 @@
+// The wide BVH's kernels as the registry hands them to the accelerator: one table per instruction
+// set. The kernels themselves (bvh_kernels.inl) are compiled in each set's unit of the registry
+// (accel/kernels_<isa>.cpp), beside the SIMD packet kernels, in eight lanes whatever that set's
+// packet width.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+
+#include "bvh/bvh_build.hpp"
+#include "kernel/traversal.hpp"
+
+namespace cellrt::detail {
+
+struct BvhKernels {
+    void (*closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+    const char* isa;  // the instruction set they are compiled for
+};
+
+}  // namespace cellrt::detail
