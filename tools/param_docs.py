@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Rewrites the parameter tables of docs/KDTREE.md, docs/BIH.md and docs/EMBREE.md from the tables
+"""Rewrites the parameter tables of docs/KDTREE.md, docs/BIH.md, docs/BVH.md and docs/EMBREE.md from the tables
 that validate the parameters, as `cellrt info --params KIND` prints them (the test
 Params.DocumentsPrintTheTablesThatValidate fails until they agree).
 
@@ -11,7 +11,7 @@ import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-DOCS = {"kd": "KDTREE.md", "bih": "BIH.md", "embree": "EMBREE.md"}
+DOCS = {"kd": "KDTREE.md", "bih": "BIH.md", "bvh": "BVH.md", "embree": "EMBREE.md"}
 
 
 def table(cellrt, kind):

@@ -49,7 +49,7 @@ struct AccelConfig {
 struct TreeReport {
     std::size_t nodes = 0, inner_nodes = 0, leaves = 0, empty_leaves = 0;
     std::optional<std::size_t> empty_space_nodes;  // BIH: inner nodes that cut off empty space
-    int depth_limit = 0, max_depth = 0;
+    int depth_limit = 0, max_depth = 0;   // depth_limit 0: none
     double mean_leaf_depth = 0.0;          // over non-empty leaves
     double triangles_per_leaf = 0.0;       // over non-empty leaves
     double references_per_triangle = 0.0;  // leaf entries per scene triangle

@@ -58,8 +58,9 @@ struct WatertightRay {
 // (kernel/traversal.hpp): a unit that instantiates many kernels exhausts GCC's inlining budget,
 // and an out-of-line call costs a kernel up to a tenth of its instructions (docs/BENCHMARKS.md).
 [[gnu::always_inline]] inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
-    // The vertices' coordinates in ray order (x, y, z of v0, v1, v2 as nine floats, read by index).
-    const auto c9 = std::bit_cast<std::array<float, 9>>(tri);
+    // The vertices' coordinates in ray order (x, y, z of v0, v1, v2: the nine floats of the
+    // triangle's storage, read in place by index as Vec3::operator[] reads three).
+    const float* c9 = reinterpret_cast<const float*>(&tri);
     const float ox = r.org[r.kx], oy = r.org[r.ky], oz = r.org[r.kz];
     const float a_kz = c9[r.kz] - oz, b_kz = c9[3 + r.kz] - oz, c_kz = c9[6 + r.kz] - oz;
     const float ax = (c9[r.kx] - ox) - r.sx * a_kz, ay = (c9[r.ky] - oy) - r.sy * a_kz;

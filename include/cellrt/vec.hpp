@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
 
 namespace cellrt {
 
@@ -16,8 +17,13 @@ struct Vec3 {
     constexpr Vec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
     constexpr explicit Vec3(float s) : x(s), y(s), z(s) {}
 
-    // Indexed read as an array load (no chain of selects): the kernels index by per-ray axes.
-    constexpr float operator[](std::size_t i) const { return std::bit_cast<std::array<float, 3>>(*this)[i]; }
+    // Indexed read as one load from the vector itself (no chain of selects, no copy to the stack, as
+    // a bit_cast to an array compiles to): the kernels index by per-ray axes. The three floats are
+    // the struct's storage (Embree's Vec3 reads them the same way).
+    constexpr float operator[](std::size_t i) const {
+        if (std::is_constant_evaluated()) return i == 0 ? x : (i == 1 ? y : z);
+        return reinterpret_cast<const float*>(this)[i];
+    }
     constexpr float& operator[](std::size_t i) { return i == 0 ? x : (i == 1 ? y : z); }
 
     constexpr Vec3 operator-() const { return {-x, -y, -z}; }

@@ -39,6 +39,7 @@ public:
         r.inner_nodes = tree_.nodes.size();
         r.leaves = tree_.leaves.size();
         r.max_depth = tree_.depth;
+        r.mean_leaf_depth = tree_.mean_leaf_depth;
         r.triangles_per_leaf = tree_.mean_leaf_triangles;
         r.references_per_triangle = triangle_count_ ? 1.0 : 0.0;
         r.sah_cost = tree_.sah_cost;

@@ -175,7 +175,7 @@ public:
                 out_.nodes[index].lo[a][k] = c.box.lo[a];
                 out_.nodes[index].hi[a][k] = c.box.hi[a];
             }
-            const std::uint32_t word = c.leaf ? leaf(c) : emit(kids[k], depth + 1);
+            const std::uint32_t word = c.leaf ? leaf(c, depth + 1) : emit(kids[k], depth + 1);
             out_.nodes[index].child[k] = word;
         }
         return index;
@@ -192,7 +192,8 @@ private:
         }
     }
 
-    std::uint32_t leaf(const BinaryNode& c) {
+    std::uint32_t leaf(const BinaryNode& c, int depth) {
+        leaf_depths_ += static_cast<std::size_t>(depth);
         BvhLeaf l{};
         for (std::uint32_t lane = 0; lane < kBvhWidth; ++lane) {
             l.prim[lane] = kNoHit;
@@ -210,9 +211,14 @@ private:
         return BvhNode::leaf_word(static_cast<std::uint32_t>(out_.leaves.size() - 1), c.count);
     }
 
+public:
+    std::size_t leaf_depths() const { return leaf_depths_; }
+
+private:
     std::span<const Triangle> tris_;
     const BinaryBuilder& b_;
     BvhTree& out_;
+    std::size_t leaf_depths_ = 0;
 };
 
 }  // namespace
@@ -226,8 +232,10 @@ BvhTree build_bvh(std::span<const Triangle> triangles, const BvhBuildOptions& op
     tree.binary_nodes = builder.nodes().size();
     const double root = area(tree.bounds);
     tree.sah_cost = root > 0.0 ? builder.cost() / root : 0.0;
-    Collapser(triangles, builder, tree).emit(0, 0);
+    Collapser collapser(triangles, builder, tree);
+    collapser.emit(0, 0);
     tree.mean_leaf_triangles = double(triangles.size()) / double(tree.leaves.size());
+    tree.mean_leaf_depth = double(collapser.leaf_depths()) / double(tree.leaves.size());
     return tree;
 }
 

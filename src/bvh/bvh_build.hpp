@@ -30,6 +30,7 @@ struct BvhTree {
     std::size_t binary_nodes = 0;
     double sah_cost = 0.0;       // of the binary tree, in the options' cost units
     double mean_leaf_triangles = 0.0;
+    double mean_leaf_depth = 0.0;  // a leaf's depth is its wide parent's plus one
 };
 
 BvhTree build_bvh(std::span<const Triangle> triangles, const BvhBuildOptions& options);

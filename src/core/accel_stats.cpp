@@ -27,7 +27,7 @@ std::vector<std::pair<std::string, std::string>> AccelStats::figures() const {
     f.insert(f.end(), {
                           {"leaves", std::to_string(t.leaves)},
                           {"empty leaves", std::to_string(t.empty_leaves)},
-                          {"depth limit", std::to_string(t.depth_limit)},
+                          {"depth limit", t.depth_limit ? std::to_string(t.depth_limit) : "none"},
                           {"max depth", std::to_string(t.max_depth)},
                           {"mean leaf depth", fixed("%.2f", t.mean_leaf_depth)},
                           {"tris per leaf", fixed("%.2f", t.triangles_per_leaf)},
