@@ -20,6 +20,15 @@
 
 #include <nlohmann/json.hpp>
 
+// Under callgrind (bench/step_costs.py runs it with --instr-atstart=no) only the traced passes are
+// instrumented: loading, building and the counting passes run at valgrind's uninstrumented speed.
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#else
+#define CALLGRIND_START_INSTRUMENTATION
+#define CALLGRIND_STOP_INSTRUMENTATION
+#endif
+
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
@@ -325,7 +334,9 @@ void bench_scene(const Scene& scene, const Options& o, nlohmann::json& out) {
                 scene.triangles.size(), w, h, o.ray_kind.c_str(), s.rays.primary.size(), s.rays.secondary.size(),
                 to_string(s.rays.secondary_kind));
     std::vector<Entry> entries = build_configurations(scene, o);
+    CALLGRIND_START_INSTRUMENTATION;
     timed_passes(entries, s.rays, o);
+    CALLGRIND_STOP_INSTRUMENTATION;
     const std::vector<Result> results = results_of(entries, s);
     std::fprintf(stderr, "%s done\n", scene.name.c_str());
     print_table(results, s.rays);
