@@ -94,31 +94,6 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const Waterti
     return used & ~(negative & positive) & (det != 0.f);
 }
 
-// Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
-// True when an any-hit query is answered.
-template <class Query, class Counters>
-bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, Query& q, Counters& c) {
-    c.leaf();
-    for (std::uint32_t i = 0; i < count; ++i) c.triangle();
-    F t, u, v;
-    const I hit = watertight_leaf(leaf, count, r.watertight, t, u, v);
-    if constexpr (Query::kAnyHit) {
-        return any(hit & (t >= splat(q.tnear)) & (t <= splat(q.tfar)));
-    } else {
-        unsigned b = bits(hit & (t >= splat(q.tnear)) & (t <= splat(q.best.t)));
-        for (; b; b &= b - 1) {
-            const int i = __builtin_ctz(b);
-            if (closer(t[i], leaf.prim[i], q.best)) q.best = Hit{t[i], leaf.prim[i], u[i], v[i]};
-        }
-        return false;
-    }
-}
-
-// The children that are leaves, as a bit mask (the leaf bit is the sign bit of a child word).
-inline unsigned leaf_lanes(const BvhNode& node) {
-    return bits(reinterpret_cast<I>(load_u(node.child)) < 0) & bits(reinterpret_cast<I>(load_u(node.child)) != -1);
-}
-
 // The lanes of a bit mask, as a lane mask.
 inline I met_mask(unsigned met) {
     return (splat_i(static_cast<std::int32_t>(met)) & I{1, 2, 4, 8, 16, 32, 64, 128}) != 0;
@@ -135,29 +110,74 @@ inline float horizontal_min(F x) {
     return x[0];
 }
 
-// Starts loading a child that waits on the stack: on incoherent rays its lines are far from the
-// core, and the nearer subtree is traced meanwhile.
-inline void prefetch(const BvhNode* nodes, const BvhLeaf* leaves, std::uint32_t word) {
-    const char* p = BvhNode::is_leaf(word) ? reinterpret_cast<const char*>(&leaves[BvhNode::leaf_index(word)])
-                                           : reinterpret_cast<const char*>(&nodes[word]);
-    for (int line = 0; line < 5; ++line) __builtin_prefetch(p + 64 * line);
+// Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
+// True when an any-hit query is answered.
+template <class Query, class Counters>
+bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, Query& q, Counters& c) {
+    c.leaf();
+    for (std::uint32_t i = 0; i < count; ++i) c.triangle();
+    F t, u, v;
+    const I hit = watertight_leaf(leaf, count, r.watertight, t, u, v);
+    if constexpr (Query::kAnyHit) {
+        return any(hit & (t >= splat(q.tnear)) & (t <= splat(q.tfar)));
+    } else {
+        // The lanes' closest t by a lane minimum, not a loop over the lanes hit (whose count is
+        // data-dependent, hence mispredicted on incoherent rays); equal t falls to the lower index.
+        const I accepted = hit & (t >= splat(q.tnear)) & (t <= splat(q.best.t));
+        if (!any(accepted)) return false;
+        const F candidate = select(accepted, t, splat(kInfinity));
+        const float t_min = horizontal_min(candidate);
+        unsigned tied = bits(accepted & (candidate == splat(t_min)));
+        int i = __builtin_ctz(tied);
+        for (tied &= tied - 1; tied; tied &= tied - 1)
+            if (leaf.prim[__builtin_ctz(tied)] < leaf.prim[i]) i = __builtin_ctz(tied);
+        if (closer(t[i], leaf.prim[i], q.best)) q.best = Hit{t[i], leaf.prim[i], u[i], v[i]};
+        return false;
+    }
 }
 
-// A child waiting on the stack: its word and the distance at which the ray enters its box.
-struct BvhStackEntry {
-    std::uint32_t word;
-    float entry;
-};
+// The children that are leaves, as a bit mask (the leaf bit is the sign bit of a child word).
+inline unsigned leaf_lanes(const BvhNode& node) {
+    return bits(reinterpret_cast<I>(load_u(node.child)) < 0) & bits(reinterpret_cast<I>(load_u(node.child)) != -1);
+}
+
+#if defined(CELLRT_SIMD_AVX512)
+inline __m256i load_child_words(const BvhNode& node) {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child));
+}
+#endif
 
 // Deep enough for any tree the builder makes: each level pushes at most seven children, and the
 // binary tree is at most kSahDepth + log2(2^32) levels deep, the wide one no deeper.
 inline constexpr int kBvhStackSize = 7 * 96 + 1;
 
+// The children waiting, as two arrays (their words, and the distances at which the ray enters their
+// boxes), so that AVX-512 pushes the children met in two compressing stores, without a loop.
+struct BvhStack {
+    std::uint32_t word[kBvhStackSize];
+    float entry[kBvhStackSize];
+    int size = 0;
+
+    void push(const BvhNode& node, unsigned met, F entries) {
+#if defined(CELLRT_SIMD_AVX512)
+        _mm256_mask_compressstoreu_epi32(word + size, static_cast<__mmask8>(met), load_child_words(node));
+        _mm256_mask_compressstoreu_ps(entry + size, static_cast<__mmask8>(met), reinterpret_cast<__m256>(entries));
+        size += __builtin_popcount(met);
+#else
+        for (; met; met &= met - 1) {
+            const int k = __builtin_ctz(met);
+            word[size] = node.child[k];
+            entry[size++] = entries[k];
+        }
+#endif
+    }
+};
+
+
 template <class Query, class Counters>
 bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
     const BoxRay box_ray(r);
-    BvhStackEntry stack[kBvhStackSize];
-    int sp = 0;
+    BvhStack stack;
     std::uint32_t word = 0;  // the root, an inner node
     for (;;) {
         if (BvhNode::is_leaf(word)) {
@@ -188,19 +208,15 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
                 const F masked = select(met_mask(met), entry, splat(kInfinity));
                 const unsigned nearest = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
                 word = node.child[nearest];
-                for (met &= ~(1u << nearest); met; met &= met - 1) {
-                    const int k = __builtin_ctz(met);
-                    stack[sp++] = {node.child[k], entry[k]};
-                    prefetch(nodes, leaves, node.child[k]);
-                }
+                stack.push(node, met & ~(1u << nearest), entry);
                 continue;
             }
         }
         do {
-            if (sp == 0) return false;
-            --sp;
-        } while (stack[sp].entry > q.cull_t());
-        word = stack[sp].word;
+            if (stack.size == 0) return false;
+            --stack.size;
+        } while (stack.entry[stack.size] > q.cull_t());
+        word = stack.word[stack.size];
     }
 }
 
