@@ -8,7 +8,9 @@
 #include <functional>
 #include <vector>
 
+#include "accel/routed_accelerator.hpp"
 #include "bvh/bvh_build.hpp"
+#include "cellrt/workload.hpp"
 #include "cellrt/error.hpp"
 #include "ray_suite.hpp"
 #include "scenes.hpp"
@@ -172,6 +174,30 @@ TEST(Bvh, RefusesBadParameters) {
     AccelConfig c = bvh();
     c.traversal = "branched";
     EXPECT_THROW(make_accelerator(scene.triangles, c), Error);
+}
+
+// The router's measure: a frame's primary rays and the shadow rays of their hits are coherent, its
+// diffuse bounces and random directions are not, and invalid rays do not count.
+TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
+    const Scene& scene = test::cached_scene("builtin:city?tris=5000");
+    const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    ShadingOptions diffuse;
+    diffuse.shading = Shading::diffuse;
+    const FrameRays frame = frame_rays(scene, 64, 64, 16, *kd);
+    const FrameRays bounces = frame_rays(scene, 64, 64, 16, *kd, diffuse);
+    for (const FrameRays::Packet& p : frame.packets) {
+        EXPECT_GT(detail::batch_coherence(std::span(frame.primary).subspan(p.primary, p.primary_count)), 0.9f);
+        if (p.secondary_count > 16)
+            EXPECT_GT(detail::batch_coherence(std::span(frame.secondary).subspan(p.secondary, p.secondary_count)), 0.9f);
+    }
+    for (const FrameRays::Packet& p : bounces.packets)
+        if (p.secondary_count > 16)
+            EXPECT_LT(detail::batch_coherence(std::span(bounces.secondary).subspan(p.secondary, p.secondary_count)), 0.6f);
+    std::vector<Ray> invalid(8);
+    for (Ray& r : invalid) r.dir = {0.f, 0.f, 0.f};
+    invalid[3].dir = {1.f, 0.f, 0.f};
+    EXPECT_EQ(detail::batch_coherence(invalid), 1.f);
+    EXPECT_EQ(detail::batch_coherence({}), 1.f);
 }
 
 }  // namespace

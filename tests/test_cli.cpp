@@ -103,6 +103,8 @@ TEST(Cli, SameImageForEveryPath) {
             {"bih_branched", {"--accel", "bih", "--traversal", "branched", "--packet", "1"}},
             {"kd_portable", {"--accel", "kd", "--simd", "portable", "--packet", "7"}},
             {"brute_auto", {"--accel", "brute", "--packet", "8"}},
+            {"bvh", {"--accel", "bvh", "--packet", "4"}},
+            {"routed", {"--accel", "auto", "--threads", "2"}},
         };
         for (const auto& [name, extra] : paths) {
             const Image img = render(name, extra);

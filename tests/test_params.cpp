@@ -43,7 +43,7 @@ std::string documented_table(const std::string& doc, const std::string& kind) {
 // The documents' tables are the code's tables, row for row (`cellrt info --params KIND` prints the
 // same; rewrite a document's table from it when a parameter changes).
 TEST(Params, DocumentsPrintTheTablesThatValidate) {
-    std::vector<std::pair<std::string, std::string>> docs{{"kd", "KDTREE.md"}, {"bih", "BIH.md"}, {"bvh", "BVH.md"}};
+    std::vector<std::pair<std::string, std::string>> docs{{"kd", "KDTREE.md"}, {"bih", "BIH.md"}, {"bvh", "BVH.md"}, {"auto", "BVH.md"}};
     const auto kinds = accelerator_kinds();
     if (std::find(kinds.begin(), kinds.end(), "embree") != kinds.end()) docs.emplace_back("embree", "EMBREE.md");
     for (const auto& [kind, file] : docs)
