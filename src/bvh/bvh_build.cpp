@@ -53,8 +53,9 @@ private:
 
     int bin_of(const Vec3& c, int axis, const Box3& cbox) const {
         const float extent = cbox.hi[axis] - cbox.lo[axis];
-        const int k = static_cast<int>((c[axis] - cbox.lo[axis]) * (static_cast<float>(o_.bins) / extent));
-        return std::clamp(k, 0, o_.bins - 1);
+        const float k = (c[axis] - cbox.lo[axis]) * (static_cast<float>(o_.bins) / extent);
+        // Where extent is subnormal, bins / extent is inf and k inf or NaN, which no int holds.
+        return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(o_.bins - 1))) : 0;
     }
 
     // The cheapest binned SAH split of the node's triangles, or axis -1 when all centroids coincide.
