@@ -52,11 +52,11 @@ private:
     };
 
     // Clamped as a float, before the conversion: a centroid at the box's far side gives `bins`, and
-    // a non-finite one (a vertex at infinity) must not reach the conversion at all.
+    // where the extent is subnormal, bins / extent is inf and k inf or NaN, which no int holds.
     int bin_of(const Vec3& c, int axis, const Box3& cbox) const {
         const float extent = cbox.hi[axis] - cbox.lo[axis];
         const float k = (c[axis] - cbox.lo[axis]) * (static_cast<float>(o_.bins) / extent);
-        return k >= 0.f ? static_cast<int>(std::min(k, static_cast<float>(o_.bins - 1))) : 0;
+        return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(o_.bins - 1))) : 0;
     }
 
     // The cheapest binned SAH split of the node's triangles, or axis -1 when all centroids coincide.

@@ -30,9 +30,10 @@ std::vector<std::string> table_names(const ParamTable& table) {
 ParamReader::ParamReader(const ParamTable& table, const AccelConfig& config, std::string structure)
     : table_(table), given_(config.params), structure_(std::move(structure)) {
     std::vector<std::string> unknown;
-    for (const auto& [name, value] : given_)
-        if (std::none_of(table_.begin(), table_.end(), [&](const ParamSpec& p) { return p.name == name; }))
-            unknown.push_back(name);
+    // Not a structured binding: clang before 16 cannot capture one in a lambda.
+    for (const auto& given : given_)
+        if (std::none_of(table_.begin(), table_.end(), [&](const ParamSpec& p) { return p.name == given.first; }))
+            unknown.push_back(given.first);
     if (unknown.empty()) return;
     const std::string takes = table_.empty() ? structure_ + " takes none" : structure_ + " takes: " +
                                                                                 join_names(table_names(table_));

@@ -45,6 +45,7 @@ std::vector<BuiltinInfo> builtin_scenes() {
 std::string default_scene_spec() { return "builtin:city"; }
 
 Scene make_builtin_scene(const std::string& spec) {
+    if (spec.rfind("builtin:", 0) != 0) throw Error(spec + ": a built-in scene's spec starts with 'builtin:'");
     std::string_view rest = std::string_view(spec).substr(std::string_view("builtin:").size());
     const std::size_t q = rest.find('?');
     const std::string_view name = rest.substr(0, q);
