@@ -79,15 +79,23 @@ class Accelerator {
 public:
     virtual ~Accelerator() = default;
 
-    // Closest hit of each ray under the hit rule of ray.hpp; hits.size() must equal rays.size().
-    virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits,
-                           TraversalCounters* counters = nullptr) const = 0;
+    // Closest hit of each ray under the hit rule of ray.hpp. Throws cellrt::Error when hits.size()
+    // differs from rays.size() (checked once per call, before any ray is traced).
+    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters = nullptr) const;
 
-    // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0.
-    virtual void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                          TraversalCounters* counters = nullptr) const = 0;
+    // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0. Throws
+    // cellrt::Error when occluded.size() differs from rays.size().
+    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                  TraversalCounters* counters = nullptr) const;
 
     virtual AccelStats stats() const = 0;
+
+private:
+    // What each structure implements, called by intersect() and occluded() with spans of equal length,
+    // so that no structure has to check them again.
+    virtual void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const = 0;
+    virtual void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                             TraversalCounters* counters) const = 0;
 };
 
 }  // namespace cellrt

@@ -19,14 +19,6 @@ public:
         build_seconds_ = timer.seconds();
     }
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        kernels_.closest(tree_, rays, hits, counters);
-    }
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        kernels_.any(tree_, rays, occluded, counters);
-    }
-
     AccelStats stats() const override {
         AccelStats s;
         s.name = "bvh";
@@ -53,6 +45,14 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        kernels_.closest(tree_, rays, hits, counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        kernels_.any(tree_, rays, occluded, counters);
+    }
+
     detail::BvhBuildOptions options_;
     const detail::BvhKernels& kernels_;
     std::size_t triangle_count_;

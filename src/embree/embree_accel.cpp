@@ -226,29 +226,6 @@ public:
         build_seconds_ = build.seconds();
     }
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        switch (options_.width) {
-            case 4: intersect_packets<4>(rays, hits); break;
-            case 8: intersect_packets<8>(rays, hits); break;
-            case 16: intersect_packets<16>(rays, hits); break;
-            default: intersect_single(rays, hits); break;
-        }
-        errors_.throw_if_failed("intersect");
-        if (counters) counters->rays += rays.size();
-    }
-
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        switch (options_.width) {
-            case 4: occluded_packets<4>(rays, occluded); break;
-            case 8: occluded_packets<8>(rays, occluded); break;
-            case 16: occluded_packets<16>(rays, occluded); break;
-            default: occluded_single(rays, occluded); break;
-        }
-        errors_.throw_if_failed("occluded");
-        if (counters) counters->rays += rays.size();
-    }
-
     AccelStats stats() const override {
         AccelStats s;
         s.name = "embree";
@@ -269,6 +246,29 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        switch (options_.width) {
+            case 4: intersect_packets<4>(rays, hits); break;
+            case 8: intersect_packets<8>(rays, hits); break;
+            case 16: intersect_packets<16>(rays, hits); break;
+            default: intersect_single(rays, hits); break;
+        }
+        errors_.throw_if_failed("intersect");
+        if (counters) counters->rays += rays.size();
+    }
+
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        switch (options_.width) {
+            case 4: occluded_packets<4>(rays, occluded); break;
+            case 8: occluded_packets<8>(rays, occluded); break;
+            case 16: occluded_packets<16>(rays, occluded); break;
+            default: occluded_single(rays, occluded); break;
+        }
+        errors_.throw_if_failed("occluded");
+        if (counters) counters->rays += rays.size();
+    }
+
     void create_device() {
         // Configuration files (.embree3 beside the program or in $HOME) are ignored, so that a
         // benchmark's yardstick does not depend on the user's home folder.
