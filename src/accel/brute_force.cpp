@@ -82,6 +82,7 @@ std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangle
     detail::ParamReader params(brute_force_params(), config, "brute");
     params.finish();
     detail::choose_traversal(brute_force_traversals(), config.traversal, "brute");
+    check_finite(triangles);  // again, for callers outside the registry
     return std::make_unique<BruteForce>(triangles, detail::packet_kernels_for(config));
 }
 
