@@ -194,8 +194,7 @@ struct alignas(W * sizeof(int)) ValidMask {
     int lanes[W];
 };
 
-// Traversal names and their packet widths (1: one ray per call).
-const std::vector<std::string> kTraversals = {"single", "packet4", "packet8", "packet16"};
+// The packet widths of embree_traversals() (1: one ray per call).
 constexpr int kTraversalWidths[] = {1, 4, 8, 16};
 
 RTCBuildQuality parse_quality(const std::string& name) {
@@ -458,7 +457,11 @@ const ParamTable& embree_params() {
     return table;
 }
 
-const std::vector<std::string>& embree_traversals() { return kTraversals; }
+// A function's static, for the reason bvh_traversals() gives (bvh_accel.cpp).
+const std::vector<std::string>& embree_traversals() {
+    static const std::vector<std::string> names{"single", "packet4", "packet8", "packet16"};
+    return names;
+}
 
 std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, const AccelConfig& config) {
     detail::ParamReader params(embree_params(), config, "embree");
@@ -467,9 +470,10 @@ std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, co
     options.robust = params.boolean("robust");
     options.compact = params.boolean("compact");
     params.finish();
-    options.traversal = detail::choose_traversal(kTraversals, config.traversal, "embree");
-    options.width = kTraversalWidths[std::find(kTraversals.begin(), kTraversals.end(), options.traversal) -
-                                     kTraversals.begin()];
+    const std::vector<std::string>& traversals = embree_traversals();
+    options.traversal = detail::choose_traversal(traversals, config.traversal, "embree");
+    options.width = kTraversalWidths[std::find(traversals.begin(), traversals.end(), options.traversal) -
+                                     traversals.begin()];
     options.threads = config.threads;
     return std::make_unique<EmbreeAccel>(triangles, options);
 }
