@@ -15,6 +15,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
 #include "kernel/param_reader.hpp"
+#include "kernel/subtree.hpp"
 
 namespace cellrt {
 namespace {
@@ -352,7 +353,7 @@ private:
         if (options_.threads == 0) {
             rtcCommitScene(scene_.get());
         } else {
-            tbb::task_arena arena(static_cast<int>(options_.threads));
+            tbb::task_arena arena(detail::build_concurrency(options_.threads));
             arena.execute([&] { rtcCommitScene(scene_.get()); });
         }
         errors_.throw_if_failed("build (rtcCommitScene)");
