@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
 #include "read_file.hpp"
 
@@ -44,8 +45,8 @@ public:
     int positive_int(const json& parent, const std::string& parent_name, const char* key) const {
         const std::string name = parent_name + "." + key;
         const json& j = field(parent, parent_name, key);
-        if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > 65536)
-            fail(name, "must be an integer in [1, 65536]");
+        if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > kMaxImageSide)
+            fail(name, "must be an integer in [1, " + std::to_string(kMaxImageSide) + "]");
         return static_cast<int>(j.get<long long>());
     }
 
