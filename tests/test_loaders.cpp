@@ -513,10 +513,79 @@ TEST_F(LoaderTest, ViewFileGivesMeshCameraLightAndSize) {
 
 TEST_F(LoaderTest, ViewFileInvalidJsonIsNamed) {
     const std::string path = write("bad.json", R"({"mesh": "tri.obj", "camera": )");
-    const std::string message = error_of([&] { load_view_file(path); });
-    EXPECT_EQ(message.rfind(path + ": invalid JSON: ", 0), 0u) << message;
+    EXPECT_EQ(error_of([&] { load_view_file(path); }),
+              path + ":1: invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', "
+                     "'{', or a literal");
     const std::string array = write("array.json", "[1, 2]");
     EXPECT_EQ(error_of([&] { load_view_file(array); }), array + ": a view file must be a JSON object");
+    const std::string late =
+        write("late.json", "{\n  \"mesh\": \"tri.obj\",\n  // a comment\n  \"camera\": [1,, 2]\n}\n");
+    EXPECT_EQ(error_of([&] { load_view_file(late); }),
+              late + ":4: invalid JSON: syntax error while parsing value - unexpected ','; expected '[', '{', or a "
+                     "literal");
+    const std::string utf8 = write("utf8.json", "{\n\"name\": \"\xff\"}");
+    const std::string message = error_of([&] { load_view_file(utf8); });
+    EXPECT_EQ(message.rfind(utf8 + ":2: invalid JSON: syntax error while parsing value - invalid string: ill-formed "
+                                   "UTF-8 byte",
+                            0),
+              0u)
+        << message;
+}
+
+// A number beyond a double's range is the parser's error (nlohmann's out_of_range, not a parse_error),
+// named with the file and line like any other; integers beyond 64 bits are numbers, not integers.
+TEST_F(LoaderTest, ViewFileNumbersBeyondTheirRangeAreNamed) {
+    write("tri.obj", kTriangleObj);
+    const std::string doc = view_doc().dump(1);  // a value a line
+    struct Case {
+        std::string from, to, message;  // LINE: the line of `from`
+    };
+    const std::vector<Case> cases{
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e309", ":LINE: invalid JSON: number overflow parsing '1e309'"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": -1e309", ":LINE: invalid JSON: number overflow parsing '-1e309'"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1" + std::string(400, '0'),
+         ":LINE: invalid JSON: number overflow parsing '1" + std::string(400, '0') + "'"},
+        {"\"height\": 32", "\"height\": 32e999", ":LINE: invalid JSON: number overflow parsing '32e999'"},
+        {"\"width\": 64", "\"width\": 100000000000000000000000",
+         ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"width\": 64", "\"width\": 18446744073709551615", ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"width\": 64", "\"width\": -9223372036854775809", ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e-400", ": camera fov_y_deg = 0.000000 must lie in (0, 180)"},
+    };
+    for (const Case& c : cases) {
+        std::string text = doc;
+        const std::size_t at = text.find(c.from);
+        ASSERT_NE(at, std::string::npos) << text;
+        text.replace(at, c.from.size(), c.to);
+        std::string message = c.message;
+        if (message.starts_with(":LINE:"))
+            message.replace(1, 4, std::to_string(1 + std::count(text.begin(), text.begin() + at, '\n')));
+        const std::string path = write("view.json", text);
+        EXPECT_EQ(error_of([&] { load_view_file(path); }), path + message) << c.to;
+        EXPECT_EQ(error_of([&] { load_scene(path); }), path + message) << c.to;
+    }
+}
+
+// An image too large to allocate is refused, though each side alone is allowed.
+TEST_F(LoaderTest, ViewFileImageOfTooManyPixelsIsRefused) {
+    write("tri.obj", kTriangleObj);
+    json doc = view_doc();
+    doc["image"] = {{"width", 65536}, {"height", 65536}};
+    const std::string path = write("view.json", doc.dump());
+    EXPECT_EQ(error_of([&] { load_view_file(path); }),
+              path + ": image size 65536x65536 has 4294967296 pixels, more than the largest image's 268435456");
+}
+
+// A path the system cannot look up (here a name longer than NAME_MAX) is an error naming it, not an
+// exception of std::filesystem.
+TEST_F(LoaderTest, PathsTheSystemCannotLookUpAreNamed) {
+    const std::string name = (dir_ / (std::string(300, 'a') + ".obj")).string();
+    EXPECT_EQ(error_of([&] { load_scene(name); }), name + ": cannot look the file up: File name too long");
+    json doc = view_doc();
+    doc["mesh"] = std::string(300, 'm') + ".obj";
+    const std::string view = write("view.json", doc.dump());
+    const std::string mesh = (dir_ / (std::string(300, 'm') + ".obj")).string();
+    EXPECT_EQ(error_of([&] { load_view_file(view); }), mesh + ": cannot look the file up: File name too long");
 }
 
 TEST_F(LoaderTest, ViewFileNamesEachMissingField) {

@@ -8,6 +8,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
 #include "cellrt/loaders.hpp"
+#include "read_file.hpp"
 
 namespace cellrt {
 
@@ -51,7 +52,7 @@ std::vector<Triangle> load_mesh(const std::string& path) {
 
 Scene load_scene(const std::string& spec) {
     if (spec.rfind("builtin:", 0) == 0) return make_builtin_scene(spec);
-    if (!std::filesystem::exists(spec)) throw Error(spec + ": no such file");
+    if (!detail::file_exists(spec)) throw Error(spec + ": no such file");
     if (lower_extension(spec) == ".json") return load_view_file(spec);
     Scene scene;
     scene.name = std::filesystem::path(spec).stem().string();
