@@ -133,6 +133,9 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {"v nan 0 0\n", ":1: vertex coordinate 'nan' is not finite"},
         {"v 0 -inf 0\n", ":1: vertex coordinate '-inf' is not finite"},
         {"v 0 0 1e39\n", ":1: vertex coordinate '1e39' is not finite"},
+        {"v 1e309 0 0\n", ":1: vertex coordinate '1e309' is not finite"},
+        {"v 0 -1e309 0\n", ":1: vertex coordinate '-1e309' is not finite"},
+        {"v 0 0 0 1e309\n", ":1: vertex coordinate '1e309' is not finite"},
         {kSquareVertices + "f 1 2\n", ":5: face needs at least three vertices, has 2"},
         {kSquareVertices + "f\n", ":5: face needs at least three vertices, has 0"},
         {kSquareVertices + "f 1 2 x\n", ":5: malformed face index 'x'"},
@@ -142,6 +145,12 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {kSquareVertices + "f 1 2 3\nf 1 2 6\nv 0 0 1\n", ":6: face index 6 is out of range (the file has 5 vertices)"},
         {kSquareVertices + "f 1 2 3\r\nf 2 3 9\r\n", ":6: face index 9 is out of range (the file has 4 vertices)"},
         {kSquareVertices + "f -5 -2 -1\nv 0 0 1\n", ":5: face index -5 is out of range (the file has 5 vertices)"},
+        {kSquareVertices + "f 1 2 99999999999999999999\n", ":5: face index 99999999999999999999 is out of range"},
+        {kSquareVertices + "f -99999999999999999999/1 1 2\n", ":5: face index -99999999999999999999 is out of range"},
+        {kSquareVertices + "f 1 2 9223372036854775807\n",
+         ":5: face index 9223372036854775807 is out of range (the file has 4 vertices)"},
+        {kSquareVertices + "f -9223372036854775808 1 2\n",
+         ":5: face index -9223372036854775808 is out of range (the file has 4 vertices)"},
     };
     for (const Case& c : cases) {
         const std::string path = write("bad.obj", c.text);
@@ -355,6 +364,10 @@ TEST_F(LoaderTest, PlyMalformedHeaderNamesFileAndLine) {
                                                        "integer"},
         {"ply\nformat ascii 1.0\nelement vertex\n", ":3: expected 'element NAME COUNT' with COUNT a non-negative "
                                                     "integer"},
+        {"ply\nformat ascii 1.0\nelement vertex 18446744073709551616\n",
+         ":3: element count 18446744073709551616 is out of range (at most 18446744073709551615)"},
+        {"ply\nformat ascii 1.0\nelement vertex 1e309\n", ":3: expected 'element NAME COUNT' with COUNT a "
+                                                          "non-negative integer"},
         {"ply\nformat ascii 1.0\nproperty float x\n", ":3: property before any element"},
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float16 x\n",
          ":4: unknown property type 'float16' (expected char, uchar, short, ushort, int, uint, float, double or int8 "
@@ -414,6 +427,12 @@ TEST_F(LoaderTest, PlyMalformedAsciiBodyNamesFileAndLine) {
         {"0 0 0\n1 0 0\n1 1 0\n3 0 1 99999999999 0\n", ":14: value 99999999999 is out of range for int"},
         {"0 0 0\nnan 0 0\n1 1 0\n3 0 1 2 0\n", ":12: vertex coordinate is not finite (as a float)"},
         {"0 0 0\n1 0 0\n1 1 1e39\n3 0 1 2 0\n", ":13: value 1e39 is out of range for float"},
+        {"0 0 0\n1 0 0\n1 1 1e309\n3 0 1 2 0\n", ":13: value 1e309 is out of range for float"},
+        {"0 0 0\n-1e309 0 0\n1 1 0\n3 0 1 2 0\n", ":12: value -1e309 is out of range for float"},
+        {"0 0 0\n1 0 0\n1 1 0\n3 0 1 99999999999999999999 0\n",
+         ":14: value 99999999999999999999 is out of range for int"},
+        {"0 0 0\n1 0 0\n1 1 0\n99999999999999999999 0 1 2 0\n",
+         ":14: value 99999999999999999999 is out of range for uchar"},
         {"0 0 0\n1 0 0\n1 1 0\n3 0 1 3 0\n", ":14: vertex index 3 is out of range (the file has 3 vertices)"},
         {"0 0 0\n1 0 0\n1 1 0\n3 0 -1 2 0\n", ":14: vertex index -1 is out of range (the file has 3 vertices)"},
         {"0 0 0\n1 0 0\n1 1 0\n2 0 1 0\n", ":14: face needs at least three vertices, has 2"},
@@ -479,6 +498,33 @@ TEST_F(LoaderTest, PlyHugeCountsInAShortFileAreTruncationNotExhaustion) {
                                                    kXyz + "end_header\n");
     EXPECT_EQ(error_of([&] { load_ply(path); }),
               path + ": vertex 0: unexpected end of file (the binary data is truncated)");
+    const std::string ascii = write("huge_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 18446744073709551615\n" +
+                                                          kXyz + "end_header\n0 0 0\n");
+    EXPECT_EQ(error_of([&] { load_ply(ascii); }),
+              ascii + ":9: unexpected end of file: element 'vertex' has 18446744073709551615 records, the file ends "
+                      "after 1");
+    // A list of 2^32 - 1 corners in a face of a few bytes.
+    std::string list = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n" + kXyz +
+                       "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+    for (int i = 0; i < 9; ++i) put<float>(list, 0.f, Endian::Little);
+    put<std::uint32_t>(list, 0xffffffffu, Endian::Little);
+    for (int i = 0; i < 3; ++i) put<std::int32_t>(list, i, Endian::Little);
+    const std::string corners = write("corners.ply", list);
+    EXPECT_EQ(error_of([&] { load_ply(corners); }),
+              corners + ": face 0: unexpected end of file (the binary data is truncated)");
+}
+
+// Numbers beyond a double's range in a float64 property, as text.
+TEST_F(LoaderTest, PlyDoublesBeyondTheirRangeAreRefused) {
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                               "property double z\nend_header\n";
+    for (const std::string bad : {"1e309", "-1e309", "1e99999"}) {
+        const std::string path = write("d.ply", header + "0 0 0\n0 " + bad + " 0\n0 0 0\n");
+        EXPECT_EQ(error_of([&] { load_ply(path); }), path + ":9: value " + bad + " is out of range for double");
+    }
+    // Within double's range but beyond float's: a coordinate cellrt cannot hold.
+    const std::string path = write("d.ply", header + "0 0 0\n0 1e300 0\n0 0 0\n");
+    EXPECT_EQ(error_of([&] { load_ply(path); }), path + ":9: vertex coordinate is not finite (as a float)");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -108,6 +108,30 @@ TEST(Params, UnknownNamesAndValuesOutOfRangeAreRefused) {
     }
     EXPECT_THROW(accelerator_params("octree"), Error);
     EXPECT_THROW(accelerator_traversals("octree"), Error);
+    // Numbers beyond a double's or a long's range are out of the parameter's range, NaN is no number.
+    auto error_of = [](const std::string& kind, const std::string& name, const std::string& value) {
+        AccelConfig c;
+        c.kind = kind;
+        c.params = {{name, value}};
+        try {
+            make_accelerator(small_scene(), c);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    auto range_of = [](const std::string& kind, const std::string& name) {
+        for (const ParamSpec& p : accelerator_params(kind))
+            if (p.name == name) return param_range(p);
+        return std::string("(no parameter ") + name + ")";
+    };
+    for (const std::string v : {"1e309", "-1e309", "inf", "-inf"})
+        EXPECT_EQ(error_of("kd", "traversal_cost", v),
+                  "kd parameter traversal_cost=" + v + " is out of range " + range_of("kd", "traversal_cost"));
+    EXPECT_EQ(error_of("kd", "traversal_cost", "nan"), "kd parameter traversal_cost='nan' is not a number");
+    for (const std::string v : {"99999999999999999999", "-99999999999999999999", "9223372036854775807"})
+        EXPECT_EQ(error_of("bih", "leaf_size", v),
+                  "bih parameter leaf_size=" + v + " is out of range " + range_of("bih", "leaf_size"));
     EXPECT_THROW(make_accelerator(small_scene(), AccelConfig{"octree"}), Error);
 }
 
