@@ -3,7 +3,13 @@
 // or a tile), so the one virtual dispatch is paid per batch, never per ray. The structures and their
 // registry are in cellrt/accel.hpp.
 //
-// Thread safety: intersect() and occluded() are const and may run concurrently on one accelerator.
+// Thread safety: intersect(), occluded() and stats() are const and may run at once from any number of
+// threads on one accelerator of any kind (each thread of the local-store model is a worker with a
+// local store of its own), and every call gets the answers it gets alone. Calls that run at once must
+// not share a TraversalCounters (it is summed unsynchronised) nor write overlapping result spans; a
+// local-store accelerator's statistics are read between traces (local_store.hpp). Destroying an
+// accelerator while a call runs on it is undefined, as for any object. What an accelerator keeps of
+// the triangles it was built over: cellrt/accel.hpp.
 #pragma once
 
 #include <cstdint>
