@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -155,6 +156,26 @@ TEST(Params, BihSahCostsShapeTheTree) {
         return make_accelerator(small_scene(), c)->stats().tree.value().nodes;
     };
     EXPECT_LT(nodes("1"), nodes("1000"));
+}
+
+// An accelerator spec splits into its parts (checked later by make_accelerator); a parameter without
+// a name or an '=' is refused in the spec's words.
+TEST(Params, AcceleratorSpecsSplitOrAreRefused) {
+    const AccelConfig c = parse_accel_config("kd:rec+avx2@leaf_size=2,bins=64");
+    EXPECT_EQ(c.kind, "kd");
+    EXPECT_EQ(c.traversal, "rec");
+    EXPECT_EQ(c.simd, "avx2");
+    EXPECT_EQ(c.params, (std::map<std::string, std::string>{{"leaf_size", "2"}, {"bins", "64"}}));
+    for (const auto& [spec, part] : std::vector<std::pair<std::string, std::string>>{
+             {"kd@", ""}, {"kd@leaf_size", "leaf_size"}, {"kd@=2", "=2"}, {"kd@a=1,,b=2", ""}, {"kd@a=1,", ""}}) {
+        try {
+            parse_accel_config(spec);
+            ADD_FAILURE() << spec << " accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()), "accelerator parameter '" + part + "' must have the form NAME=VALUE");
+        }
+    }
+    EXPECT_THROW(make_accelerator(small_scene(), parse_accel_config("kd+avx2:rec")), Error);  // SIMD set 'avx2:rec'
 }
 
 }  // namespace
