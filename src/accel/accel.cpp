@@ -81,8 +81,12 @@ const ParamTable& accelerator_params(const std::string& kind) { return *entry(ki
 
 const std::vector<std::string>& accelerator_traversals(const std::string& kind) { return entry(kind).traversals; }
 
+// Non-finite vertices are refused here (and in make_local_store_accelerator), once for every kind and
+// before any build meets them.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config) {
-    return entry(config.kind).make(triangles, config);
+    const Entry& e = entry(config.kind);
+    check_finite(triangles);
+    return e.make(triangles, config);
 }
 
 std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
@@ -99,6 +103,7 @@ std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<co
     if (config.simd != "off")
         throw Error("the local-store model runs the single-ray kernels, not SIMD packets (simd '" + config.simd +
                     "')");
+    check_finite(triangles);
     return e.local_store(triangles, config, local_store);
 }
 
