@@ -187,12 +187,15 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
     const FrameRays bounces = frame_rays(scene, 64, 64, 16, *kd, diffuse);
     for (const FrameRays::Packet& p : frame.packets) {
         EXPECT_GT(detail::batch_coherence(std::span(frame.primary).subspan(p.primary, p.primary_count)), 0.9f);
-        if (p.secondary_count > 16)
+        if (p.secondary_count > 16) {
             EXPECT_GT(detail::batch_coherence(std::span(frame.secondary).subspan(p.secondary, p.secondary_count)), 0.9f);
+        }
     }
-    for (const FrameRays::Packet& p : bounces.packets)
-        if (p.secondary_count > 16)
+    for (const FrameRays::Packet& p : bounces.packets) {
+        if (p.secondary_count > 16) {
             EXPECT_LT(detail::batch_coherence(std::span(bounces.secondary).subspan(p.secondary, p.secondary_count)), 0.6f);
+        }
+    }
     std::vector<Ray> invalid(8);
     for (Ray& r : invalid) r.dir = {0.f, 0.f, 0.f};
     invalid[3].dir = {1.f, 0.f, 0.f};

@@ -18,14 +18,6 @@ public:
         : coherent_(std::move(coherent)), incoherent_(std::move(incoherent)), threshold_(threshold),
           packets_(std::move(packets)) {}
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        route(rays).intersect(rays, hits, counters);
-    }
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        route(rays).occluded(rays, occluded, counters);
-    }
-
     AccelStats stats() const override {
         const AccelStats c = coherent_->stats(), i = incoherent_->stats();
         AccelStats s;
@@ -40,6 +32,14 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        route(rays).intersect(rays, hits, counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        route(rays).occluded(rays, occluded, counters);
+    }
+
     const Accelerator& route(std::span<const Ray> rays) const {
         return batch_coherence(rays) >= threshold_ ? *coherent_ : *incoherent_;
     }
