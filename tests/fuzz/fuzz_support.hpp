@@ -38,14 +38,16 @@ inline std::string_view as_text(const std::uint8_t* data, std::size_t size) {
 
 // The parser's result, or nullopt where it refused the input with a cellrt::Error, the one way a
 // parser may refuse. Any other exception escapes to libFuzzer, which reports it as a crash. Where
-// `prefix` is given, the message must start with it (the loaders' messages name the file first).
+// `prefix` is given, the message must start with it (the loaders' messages name the file first, the
+// specs' the spec), as far as a message can hold it: what() ends at a NUL byte.
 template <class Parse>
 auto parse_or_refuse(Parse&& parse, std::string_view prefix = {}) -> std::optional<decltype(parse())> {
     try {
         return parse();
     } catch (const Error& e) {
         const std::string_view message = e.what();
-        if (message.size() <= prefix.size() || message.substr(0, prefix.size()) != prefix)
+        const std::string_view readable = prefix.substr(0, prefix.find('\0'));
+        if (message.substr(0, readable.size()) != readable || (message.empty() && readable.size() == prefix.size()))
             fail("a refusal without a message naming '" + std::string(prefix) + "': " + std::string(message));
         return std::nullopt;
     }
