@@ -270,6 +270,25 @@ inline void check_bare_mesh(const std::string& path, std::span<const Triangle> l
     check_scene_and_agreement(*scene, "load_scene of a bare mesh");
 }
 
+// A mesh target's input: written to a scratch file `name` and read by `load`; a refusal must name
+// the file, and what is accepted must be finite. Nothing when refused.
+template <class Load>
+std::optional<std::vector<Triangle>> load_mesh(std::string_view text, const std::string& name, Load&& load,
+                                               const std::string& what) {
+    const std::string path = write_scratch(name, text);
+    auto triangles = parse_or_refuse([&] { return load(path); }, path);
+    if (triangles) check_finite(*triangles, what);
+    return triangles;
+}
+
+// A reader's triangle count against what its file declares: exactly, or (where a face may be
+// split into several triangles) at least.
+inline void check_count(std::size_t read, std::size_t declared, bool at_least, const std::string& what) {
+    if (at_least ? read >= declared : read == declared) return;
+    fail(what + " read " + std::to_string(read) + " triangles, the file declares " +
+         (at_least ? "at least " : "") + std::to_string(declared));
+}
+
 // A small fixed scene for the grammars that configure structures: a quad of two triangles sharing
 // an edge, a copy of one of them (a tie, which the lower index wins), a triangle through the quad,
 // a degenerate one, an axis-aligned sliver and a far one; seen by a camera at an angle.

@@ -28,13 +28,9 @@ std::size_t declared_triangles(std::string_view text) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace cellrt;
     const std::string_view text = fuzz::as_text(data, size);
-    const std::string path = fuzz::write_scratch("mesh.obj", text);
-    const auto triangles = fuzz::parse_or_refuse([&] { return load_obj(path); }, path);
+    const auto triangles = fuzz::load_mesh(text, "mesh.obj", [](const std::string& p) { return load_obj(p); }, "load_obj");
     if (!triangles) return 0;
-    fuzz::check_finite(*triangles, "load_obj");
-    if (triangles->size() != declared_triangles(text))
-        fuzz::fail("load_obj read " + std::to_string(triangles->size()) + " triangles, the faces declare " +
-                   std::to_string(declared_triangles(text)));
-    fuzz::check_bare_mesh(path, *triangles);
+    fuzz::check_count(triangles->size(), declared_triangles(text), false, "load_obj");
+    fuzz::check_bare_mesh(fuzz::write_scratch("mesh.obj", text), *triangles);
     return 0;
 }

@@ -68,23 +68,24 @@ std::string encode(std::span<const Triangle> triangles, Encoding encoding) {
     return out;
 }
 
+// What an accepted PLY must satisfy: its faces' triangles, and the same triangles read back from
+// each encoding it is written in.
+void check_accepted(std::string_view text, const std::vector<cellrt::Triangle>& triangles) {
+    using namespace cellrt;
+    fuzz::check_count(triangles.size(), declared_faces(text), true, "load_ply");
+    for (const Encoding encoding : {Encoding::ascii, Encoding::little, Encoding::big}) {
+        const std::string copy = fuzz::write_scratch("copy.ply", encode(triangles, encoding));
+        if (!fuzz::same_triangles(load_ply(copy), triangles))
+            fuzz::fail("the mesh written as PLY (" + std::to_string(static_cast<int>(encoding)) + ") reads back otherwise");
+    }
+    fuzz::check_bare_mesh(fuzz::write_scratch("mesh.ply", text), triangles);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    using namespace cellrt;
-    const std::string_view text = fuzz::as_text(data, size);
-    const std::string path = fuzz::write_scratch("mesh.ply", text);
-    const auto triangles = fuzz::parse_or_refuse([&] { return load_ply(path); }, path);
-    if (!triangles) return 0;
-    fuzz::check_finite(*triangles, "load_ply");
-    if (triangles->size() < declared_faces(text))
-        fuzz::fail("load_ply read " + std::to_string(triangles->size()) + " triangles from " +
-                   std::to_string(declared_faces(text)) + " faces");
-    for (const Encoding encoding : {Encoding::ascii, Encoding::little, Encoding::big}) {
-        const std::string copy = fuzz::write_scratch("copy.ply", encode(*triangles, encoding));
-        if (!fuzz::same_triangles(load_ply(copy), *triangles))
-            fuzz::fail("the mesh written as PLY (" + std::to_string(static_cast<int>(encoding)) + ") reads back otherwise");
-    }
-    fuzz::check_bare_mesh(path, *triangles);
+    const std::string_view text = cellrt::fuzz::as_text(data, size);
+    auto load = [](const std::string& path) { return cellrt::load_ply(path); };
+    if (const auto triangles = cellrt::fuzz::load_mesh(text, "mesh.ply", load, "load_ply")) check_accepted(text, *triangles);
     return 0;
 }
