@@ -34,8 +34,9 @@ for t in "${targets[@]}"; do
   else
     log="$work/fuzz.log"
     [ -s "$log" ] || log="$work/replay.log"
-    echo "fuzz_$t: FAILED after $((SECONDS - start)) s; the end of $log and the input:" >&2
-    tail -n 40 "$log" >&2
+    echo "fuzz_$t: FAILED after $((SECONDS - start)) s (whole log: $log):" >&2
+    grep -a -E "what\(\)|runtime error|ERROR: (Address|Leak)Sanitizer|fuzz check failed|SUMMARY|Test unit written" "$log" >&2 ||
+      tail -n 20 "$log" >&2
     find "$work" -maxdepth 1 -type f -newer "$work/stamp" \( -name 'crash-*' -o -name 'timeout-*' -o -name 'oom-*' \
       -o -name 'leak-*' -o -name 'slow-unit-*' \) >&2
     failed+=("$t")
