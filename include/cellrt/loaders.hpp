@@ -4,6 +4,8 @@
 // std::bad_alloc.
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,7 +23,29 @@ std::vector<Triangle> load_obj(const std::string& path);
 // ASCII file give "FILE:LINE:", in binary data "FILE: ELEMENT INDEX:" (records counted from 0).
 std::vector<Triangle> load_ply(const std::string& path);
 
-// A mesh file chosen by extension (.obj or .ply), case-insensitive.
+// A glTF 2.0 scene: its triangles and the view of its first perspective camera, if any.
+struct GltfScene {
+    std::vector<Triangle> triangles;
+    std::optional<Camera> camera;
+    std::optional<float> aspect_ratio;  // the camera's width / height, where it gives one
+};
+
+// The most triangles load_gltf makes by default once the nodes' instances are flattened: a mesh
+// referenced by many nodes would otherwise let a small file ask for any amount of memory.
+inline constexpr std::size_t kMaxGltfTriangles = std::size_t{1} << 28;
+
+// glTF 2.0 (docs/GLTF.md): a .gltf file (JSON; buffers in files beside it or embedded as base64
+// data URIs) or a .glb file (binary container), read through tinygltf. The default scene (or the
+// first) is flattened: every node's meshes in world space under the product of its ancestors'
+// transforms (matrix or translation-rotation-scale). Only triangle primitives (mode 4) are accepted;
+// any other mode is refused. Accessors are checked for type (POSITION: VEC3 of float; indices:
+// SCALAR of unsigned byte, short or int), counts, byte ranges inside their buffer view and buffer, and
+// indices below the vertex count. Errors say "FILE: mesh M ('NAME') primitive P: ..." or name the node,
+// accessor, buffer view or camera at fault; more than `max_triangles` triangles are refused before
+// any is made.
+GltfScene load_gltf(const std::string& path, std::size_t max_triangles = kMaxGltfTriangles);
+
+// A mesh file chosen by extension (.obj, .ply, .gltf or .glb), case-insensitive.
 std::vector<Triangle> load_mesh(const std::string& path);
 
 // View file (JSON, format of shared/scenes/README.md): the mesh path relative to the file, camera,
