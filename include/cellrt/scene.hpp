@@ -33,8 +33,8 @@ struct Scene {
     Box3 bounds() const;
 };
 
-// Loads `spec`: a view file (*.json, format of shared/scenes/README.md), a mesh (*.obj, *.ply) shown
-// by default_view(), or `builtin:NAME[?key=value&...]` (builtin.hpp). Throws cellrt::Error with a
+// Loads `spec`: a view file (*.json, format of shared/scenes/README.md), a mesh (*.obj, *.ply, *.gltf,
+// *.glb) shown by default_view() (a glTF file by its first perspective camera where it has one), or `builtin:NAME[?key=value&...]` (builtin.hpp). Throws cellrt::Error with a
 // message naming the file and line or the field at fault.
 Scene load_scene(const std::string& spec);
 

@@ -1,12 +1,15 @@
 #include "cellrt/scene.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "cellrt/builtin.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
+#include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
 #include "read_file.hpp"
 
@@ -47,7 +50,8 @@ std::vector<Triangle> load_mesh(const std::string& path) {
     const std::string ext = lower_extension(path);
     if (ext == ".obj") return load_obj(path);
     if (ext == ".ply") return load_ply(path);
-    throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj or .ply)");
+    if (ext == ".gltf" || ext == ".glb") return load_gltf(path).triangles;
+    throw Error(path + ": unknown mesh format '" + ext + "' (expected .obj, .ply, .gltf or .glb)");
 }
 
 Scene load_scene(const std::string& spec) {
@@ -56,9 +60,24 @@ Scene load_scene(const std::string& spec) {
     if (lower_extension(spec) == ".json") return load_view_file(spec);
     Scene scene;
     scene.name = std::filesystem::path(spec).stem().string();
-    scene.triangles = load_mesh(spec);
+    std::optional<Camera> camera;
+    std::optional<float> aspect;
+    if (const std::string ext = lower_extension(spec); ext == ".gltf" || ext == ".glb") {
+        GltfScene gltf = load_gltf(spec);
+        scene.triangles = std::move(gltf.triangles);
+        camera = gltf.camera;
+        aspect = gltf.aspect_ratio;
+    } else {
+        scene.triangles = load_mesh(spec);
+    }
     if (scene.triangles.empty()) throw Error(spec + ": the mesh has no triangles");
     set_default_view(scene);
+    // A glTF file's first perspective camera is its view; the light stays the default one's, and
+    // the camera's aspect ratio, where given, sets the width beside the default height.
+    if (camera) scene.camera = *camera;
+    if (aspect)
+        scene.width = static_cast<int>(std::clamp(std::lround(static_cast<double>(scene.height) * *aspect), 1L,
+                                                  static_cast<long>(kMaxImageSide)));
     validate_scene(scene, spec);
     return scene;
 }

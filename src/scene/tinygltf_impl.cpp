@@ -1,7 +1,3 @@
-// tinygltf's implementation (Debian's header-only tiny_gltf.h), compiled into cellrt without image
-// decoding: cellrt reads geometry and cameras only, so images are neither decoded nor read from files.
+// tinygltf's implementation, compiled once into cellrt (tinygltf.hpp).
 #define TINYGLTF_IMPLEMENTATION
-#define TINYGLTF_NO_STB_IMAGE
-#define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
-#include <tiny_gltf.h>
+#include "tinygltf.hpp"
