@@ -18,7 +18,7 @@ std::atomic<bool> g_cancel{false};
 std::string scene_help() {
     std::string names;
     for (const auto& b : builtin_scenes()) names += (names.empty() ? "" : ", ") + b.name;
-    return "Scene: VIEW.json, MESH.obj, MESH.ply, or builtin:NAME[?tris=N&seed=S] (" + names + ")";
+    return "Scene: VIEW.json, MESH.obj, MESH.ply, SCENE.gltf, SCENE.glb, or builtin:NAME[?tris=N&seed=S] (" + names + ")";
 }
 
 void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {

@@ -1,20 +1,25 @@
-# Installs the build tree into a fresh prefix, then configures, builds and runs tests/consumer
-# against it, as a user would. Arguments: SOURCE, BUILD, WORK.
+# Installs the build tree into a fresh prefix, then configures, builds and runs tests/consumer (C++,
+# cellrt::cellrt) and tests/consumer_c (C99, cellrt::cellrt_c) against it, as users would.
+# Arguments: SOURCE, BUILD, WORK.
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix RESULT_VARIABLE rc OUTPUT_QUIET)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "cmake --install failed")
 endif()
-execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE}/tests/consumer -B ${WORK}/consumer -G Ninja
-                        -DCMAKE_PREFIX_PATH=${WORK}/prefix RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "configuring a project with find_package(cellrt) failed")
-endif()
-execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/consumer RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "building against the installed cellrt failed")
-endif()
-execute_process(COMMAND ${WORK}/consumer/app RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "the user's program did not hit the scene")
-endif()
+foreach(project consumer consumer_c)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE}/tests/${project} -B ${WORK}/${project} -G Ninja
+                          -DCMAKE_PREFIX_PATH=${WORK}/prefix RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "configuring ${project} with find_package(cellrt) failed")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/${project} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "building ${project} against the installed cellrt failed")
+  endif()
+endforeach()
+foreach(program consumer/app consumer_c/app_c)
+  execute_process(COMMAND ${WORK}/${program} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the user's program ${program} did not hit the scene")
+  endif()
+endforeach()

@@ -184,7 +184,7 @@ TEST_F(LoaderTest, MeshFormatFollowsTheExtensionInAnyCase) {
     EXPECT_EQ(scene.triangles, want);
     EXPECT_EQ(scene.name, "c");
     const std::string stl = write("d.stl", obj);
-    EXPECT_EQ(error_of([&] { load_mesh(stl); }), stl + ": unknown mesh format '.stl' (expected .obj or .ply)");
+    EXPECT_EQ(error_of([&] { load_mesh(stl); }), stl + ": unknown mesh format '.stl' (expected .obj, .ply, .gltf or .glb)");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -34,7 +34,7 @@ struct GltfScene {
 // referenced by many nodes would otherwise let a small file ask for any amount of memory.
 inline constexpr std::size_t kMaxGltfTriangles = std::size_t{1} << 28;
 
-// glTF 2.0 (docs/GLTF.md): a .gltf file (JSON; buffers in files beside it or embedded as base64
+// glTF 2.0 (docs/FORMATS.md): a .gltf file (JSON; buffers in files beside it or embedded as base64
 // data URIs) or a .glb file (binary container), read through tinygltf. The default scene (or the
 // first) is flattened: every node's meshes in world space under the product of its ancestors'
 // transforms (matrix or translation-rotation-scale). Only triangle primitives (mode 4) are accepted;

@@ -1,4 +1,4 @@
-// glTF 2.0 reader (loaders.hpp, docs/GLTF.md) over tinygltf, which parses the JSON, the GLB container
+// glTF 2.0 reader (loaders.hpp, docs/FORMATS.md) over tinygltf, which parses the JSON, the GLB container
 // and the buffers (files or base64 data URIs). tinygltf does not check that an accessor's bytes lie
 // inside its buffer, nor types, nor indices, so every one of those is checked here before a byte is
 // read, as the OBJ and PLY readers check theirs.
