@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${FUZZ_SECONDS:-60}"
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(obj ply view builtin accel cache_layout image_size)
+[ ${#targets[@]} -gt 0 ] || targets=(obj ply view builtin accel cache_layout image_size gltf)
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCELLRT_FUZZ=ON -DCELLRT_TESTS=OFF -DCELLRT_BENCH=OFF >/dev/null
