@@ -76,8 +76,8 @@ Scene load_scene(const std::string& spec) {
     // the camera's aspect ratio, where given, sets the width beside the default height.
     if (camera) scene.camera = *camera;
     if (aspect)
-        scene.width = static_cast<int>(std::clamp(std::lround(static_cast<double>(scene.height) * *aspect), 1L,
-                                                  static_cast<long>(kMaxImageSide)));
+        scene.width = static_cast<int>(std::lround(
+            std::clamp(static_cast<double>(scene.height) * *aspect, 1.0, static_cast<double>(kMaxImageSide))));
     validate_scene(scene, spec);
     return scene;
 }
