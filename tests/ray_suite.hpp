@@ -326,6 +326,12 @@ inline ReferenceAnswers stored_reference(std::span<const Triangle> tris, const s
     return stored_answers(tris, rays, [&] { return compute_reference(tris, rays); });
 }
 
+// reference_suite() of `tris`, kept on disk: the tests of every structure on the same triangles share it.
+inline ReferenceAnswers stored_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {}) {
+    const std::vector<Ray> rays = RaySuite(tris, options).rays();
+    return stored_answers(tris, rays, [&] { return reference_suite(tris, options); });
+}
+
 // reference_suite() of a triangle set, computed once and shared by every structure and traversal
 // tested on it: in memory within a process, on disk across processes.
 inline const ReferenceAnswers& cached_reference(const std::string& key, std::span<const Triangle> tris) {
@@ -333,10 +339,7 @@ inline const ReferenceAnswers& cached_reference(const std::string& key, std::spa
     static std::map<std::string, std::unique_ptr<ReferenceAnswers>> cache;
     std::lock_guard lock(mutex);
     auto& slot = cache[key];
-    if (!slot) {
-        const std::vector<Ray> rays = RaySuite(tris, RaySuiteOptions{}).rays();
-        slot = std::make_unique<ReferenceAnswers>(stored_answers(tris, rays, [&] { return reference_suite(tris); }));
-    }
+    if (!slot) slot = std::make_unique<ReferenceAnswers>(stored_suite(tris));
     return *slot;
 }
 

@@ -1,8 +1,53 @@
 #!/usr/bin/env bash
-# Second command of the README: build and run the whole test suite (CTest over GoogleTest).
-# Scene tests read ../shared/scenes, or the folder named by CELLRT_SCENES.
+# Second command of the README: build and run the whole test suite (CTest over GoogleTest) in a
+# Release build, then again under sanitizers (docs/RELIABILITY.md): all of it under AddressSanitizer and
+# UndefinedBehaviorSanitizer, and the tests that start threads under ThreadSanitizer. A stage's name
+# (release, asan or tsan) runs that stage alone. Scene tests read ../shared/scenes, or the folder named
+# by CELLRT_SCENES.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build build
-ctest --test-dir build --output-on-failure -j "$(nproc)"
+stages=("$@")
+[ "${#stages[@]}" -gt 0 ] || stages=(release asan tsan)
+jobs="$(nproc)"
+
+# Sanitized builds: -O1, which the sanitizers' documentation advises for a bearable speed, and -g,
+# for file and line in the reports; the benchmarks only for the whole-suite run, whose tests use them.
+sanitized_stage() {  # build folder, sanitizers, further CMake arguments; builds, then runs the tests
+  local dir="$1" sanitizers="$2"
+  shift 2
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+    -DCELLRT_SANITIZE="$sanitizers" "$@"
+  cmake --build "$dir"
+  ctest --test-dir "$dir" --output-on-failure -j "$jobs"
+  # CTest lists the skipped tests by name; their reasons are in its log.
+  echo "Skipped under -fsanitize=$sanitizers, and why:"
+  grep -h -B2 "built with -fsanitize" "$dir/Testing/Temporary/LastTest.log" | grep -v '^--$' || echo "(none)"
+}
+
+# Reports carry whole stacks; the Release build's cached brute-force answers serve the sanitized runs,
+# which recompute a sample of each (tests/ray_suite.hpp) instead of minutes of brute force per scene.
+export UBSAN_OPTIONS="print_stacktrace=1"
+export TSAN_OPTIONS="second_deadlock_stack=1"
+export CELLRT_TEST_CACHE="$PWD/build/tests/reference_cache"
+
+for stage in "${stages[@]}"; do
+  echo "== tools/test.sh: $stage"
+  case "$stage" in
+    release)
+      cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+      cmake --build build
+      ctest --test-dir build --output-on-failure -j "$jobs"
+      ;;
+    asan)
+      sanitized_stage build-asan address,undefined
+      ;;
+    tsan)
+      echo "ThreadSanitizer runs the tests that start threads, TBB on one thread (docs/RELIABILITY.md)"
+      sanitized_stage build-tsan thread -DCELLRT_BENCH=OFF
+      ;;
+    *)
+      echo "tools/test.sh: unknown stage '$stage' (release, asan, tsan)" >&2
+      exit 2
+      ;;
+  esac
+done
