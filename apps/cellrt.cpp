@@ -1,6 +1,7 @@
 // The cellrt command-line program: one subcommand per file (cmd_*.cpp), registered here.
 #include <csignal>
 #include <cstdio>
+#include <exception>
 
 #include "cellrt/error.hpp"
 #include "cli.hpp"
@@ -35,6 +36,11 @@ int main(int argc, char** argv) {
         return cli::g_cancel.load() ? 130 : 1;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "cellrt: error: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        // What the library did not turn into a cellrt::Error where it was thrown (each one found is
+        // a bug, fixed there) still ends with one line and status 1, not in std::terminate.
+        std::fprintf(stderr, "cellrt: error: %s\n", e.what());
         return 1;
     }
 }

@@ -1,11 +1,15 @@
 #include "cli.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
+#include <filesystem>
 #include <unistd.h>
 
 #include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/schedule.hpp"
 
 namespace cellrt::cli {
 
@@ -32,6 +36,7 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {
 }
 
 AccelConfig AccelOptions::config() const {
+    check_threads(threads);
     AccelConfig c;
     c.kind = kind;
     c.traversal = traversal;
@@ -57,6 +62,21 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
         }
         throw;
     }
+}
+
+void check_output(const std::string& path, bool overwrite) {
+    std::error_code ec;  // a path the system cannot look up is refused when it is written
+    if (!overwrite && std::filesystem::exists(path, ec))
+        throw Error(path + ": file exists (pass --overwrite to replace it)");
+}
+
+void check_threads(unsigned threads) {
+    if (threads > kMaxWorkers)
+        throw Error("--threads " + std::to_string(threads) + " must lie in [0, " + std::to_string(kMaxWorkers) + "]");
+}
+
+std::string json_report(const nlohmann::json& report) {
+    return report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 void print_stats(const AccelStats& s) {

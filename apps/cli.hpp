@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <atomic>
 #include <functional>
@@ -54,6 +55,16 @@ struct AccelOptions {
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config);
 
 void print_stats(const AccelStats& s);
+
+// Refuses at the start, before any work, to replace a file the user has (unless `overwrite`).
+void check_output(const std::string& path, bool overwrite);
+
+// Refuses a --threads of more than the library's kMaxWorkers.
+void check_threads(unsigned threads);
+
+// A JSON report as written to a file: indented, ending in a newline, any byte that is not UTF-8 (of a
+// file name, say) replaced by U+FFFD rather than failing once the work is done.
+std::string json_report(const nlohmann::json& report);
 
 
 // A one-line progress bar on stderr, shown only on a terminal and only once a render has run for a

@@ -14,9 +14,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <system_error>
 #include <thread>
 #include <unistd.h>
 
@@ -95,24 +97,34 @@ std::vector<Result> trace_all(const std::map<std::string, std::unique_ptr<LocalS
                               const std::vector<Run>& runs, const FrameRays& w, unsigned threads) {
     std::vector<Result> results(runs.size());
     std::atomic<std::size_t> next{0}, done{0};
+    // The first failure stops every thread and is rethrown here: an exception must not leave a thread
+    // (std::terminate), nor a joinable thread be destroyed when the system refuses to start the next.
     std::atomic<bool> failed{false};
-    std::string failure;
+    std::exception_ptr failure;
+    auto fail = [&](std::exception_ptr e) {
+        if (!failed.exchange(true)) failure = std::move(e);
+    };
     Progress progress;
     auto work = [&] {
         for (std::size_t i = next++; i < runs.size() && !failed && !g_cancel; i = next++) {
             try {
                 results[i] = trace(*bases.at(runs[i].structure), runs[i], w);
-            } catch (const Error& e) {
-                if (!failed.exchange(true)) failure = e.what();
+            } catch (...) {
+                fail(std::current_exception());
                 return;
             }
             progress(++done, runs.size());
         }
     };
     std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+    try {
+        for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+    } catch (const std::system_error& e) {
+        fail(std::make_exception_ptr(Error("cannot start thread " + std::to_string(pool.size() + 1) + " of " +
+                                           std::to_string(threads) + ": " + e.code().message())));
+    }
     for (auto& t : pool) t.join();
-    if (failed) throw Error(failure);
+    if (failure) std::rethrow_exception(failure);
     if (g_cancel) throw Error("cache study cancelled");
     return results;
 }
@@ -226,14 +238,13 @@ Runner add_cache_study(CLI::App& app) {
             throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
         if (o->packet < 1 || o->packet > kMaxPacket)
             throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
+        check_threads(o->threads);
         std::error_code ec;
         std::filesystem::create_directories(o->out, ec);
-        if (!std::filesystem::is_directory(o->out)) throw Error("--out '" + o->out + "': cannot create the folder");
+        if (!std::filesystem::is_directory(o->out, ec)) throw Error("--out '" + o->out + "': cannot create the folder");
         const std::string csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
         const std::string md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
-        for (const std::string& p : {csv_path, md_path})
-            if (!o->overwrite && std::filesystem::exists(p))
-                throw Error(p + ": file exists (pass --overwrite to replace it)");
+        for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
         const unsigned threads = o->threads ? o->threads : std::max(1u, std::thread::hardware_concurrency());
 
         std::string csv = csv_header();

@@ -271,8 +271,7 @@ nlohmann::json profile_json(const Scene& scene, const ProfileOptions& o, const P
 int run_profile(const ProfileOptions& o) {
     Profile p;
     p.hardware = use_hardware_counters(o.method);
-    if (!o.json.empty() && !o.overwrite && std::filesystem::exists(o.json))
-        throw Error(o.json + ": file exists (pass --overwrite to replace it)");
+    if (!o.json.empty()) check_output(o.json, o.overwrite);
     p.config = profiled_config(o.accel, p.hardware);
     const Scene scene = load_scene(o.scene);
     p.frame = profiled_frame(scene, o, p.hardware);
@@ -290,7 +289,7 @@ int run_profile(const ProfileOptions& o) {
                 with_commas(p.work.primary_rays).c_str(), with_commas(p.work.secondary_rays).c_str(),
                 with_commas(p.all.rays).c_str(), p.native_seconds, kTimedRenders);
     print_report(p.counts, p.all);
-    if (!o.json.empty()) write_file_atomically(o.json, profile_json(scene, o, p).dump(1) + "\n", o.overwrite);
+    if (!o.json.empty()) write_file_atomically(o.json, json_report(profile_json(scene, o, p)), o.overwrite);
     return 0;
 }
 

@@ -5,7 +5,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
-#include <filesystem>
 
 #include "accel/local_store_registry.hpp"
 #include "cellrt/builtin.hpp"
@@ -85,13 +84,6 @@ ShadingOptions parse_shading_options(const std::string& shading, int ao_samples,
                     "]");
     s.ao_samples = ao_samples;
     return s;
-}
-
-// Refuses at the start, before any work, to replace a file the user has.
-void check_output(const std::string& path, bool overwrite) {
-    std::error_code ec;
-    if (!overwrite && std::filesystem::exists(path, ec))
-        throw Error(path + ": file exists (pass --overwrite to replace it)");
 }
 
 double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
@@ -257,7 +249,7 @@ Runner add_render(CLI::App& app) {
                                         {"started_seconds", w.started_seconds},
                                         {"finished_seconds", w.finished_seconds}});
             if (modelled) j["local_store"] = local_store_json(*modelled);
-            write_file_atomically(o->stats, j.dump(1) + "\n", o->overwrite);
+            write_file_atomically(o->stats, json_report(j), o->overwrite);
         }
         return 0;
     };

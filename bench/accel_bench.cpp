@@ -81,7 +81,7 @@ struct Options {
     std::string scenes_dir = "../shared/scenes";
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "teapot", "builtin:city", "builtin:forest"};
     std::vector<std::string> configs{"embree:single", "embree:packet16", "kd:rec", "kd:branched", "kd:branchless",
-                                     "kd+auto", "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"};
+                                     "kd+auto", "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah", "bvh", "auto"};
     int repeats = 5, builds = 3, batch = 256, ao_samples = ShadingOptions{}.ao_samples;
     unsigned threads = 1;
     std::string size, json_path, clock = "wall", ray_kind = "frame";

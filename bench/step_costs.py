@@ -68,37 +68,49 @@ def cycles(c):
 # Each range is checked against the source (a marker that must appear in its first line), so that an
 # edit that moves the kernels makes this script fail instead of misattributing.
 
+# Per kernel: its file, a text on the line that names it, and its steps in source order, each from
+# the first line (after the previous step's) that holds its marker; the first step starts on the
+# template line above the name, the last ends at the function's closing brace. Markers are searched,
+# not line numbers kept, so an edit elsewhere does not shift them, and a marker that is gone stops the
+# script instead of misattributing.
 LINE_RULES = {
-    # function name (substring): (file, [(first, last, category, marker in the first line)])
-    "traverse_branched_from<": ("src/kernel/stack_traversal.hpp", [
-        (43, 48, "setup", "template <class Traits, class Query"),
-        (49, 73, "node", "for (;;) {"),
-        (74, 74, "leaf", "if (reached_leaf && leaves.test"),
-        (75, 77, "pop", "if (!pop_live(stack, sp, 0"),
-    ]),
-    "traverse_branched<": ("src/kernel/stack_traversal.hpp", [
-        (79, 83, "setup", "template <class Traits, class Tree"),
-    ]),
-    "traverse_branchless<": ("src/kernel/stack_traversal.hpp", [
-        (90, 99, "setup", "template <class Traits, class Tree"),
-        (100, 119, "node", "for (;;) {"),
-        (120, 123, "leaf", "if constexpr (Traits::kGaps)"),
-        (124, 126, "pop", "if (!pop_live(stack, sp, bottom"),
-    ]),
-    "kd_traverse_rec<": ("src/kdtree/kd_traversal.hpp", [
-        (83, 102, "setup", "template <class Query, class Memory"),
-        (103, 133, "node", "for (;;) {"),
-        (134, 134, "leaf", "if (leaves.test(n, mem, r, q, c)) return true;"),
-        (135, 144, "pop", "// Continue with the node"),
-    ]),
-    "traverse_bvh<": ("src/bvh/bvh_kernels.inl", [
-        (125, 130, "setup", "template <class Query, class Counters>"),
-        (131, 132, "node", "for (;;) {"),
-        (133, 133, "leaf", "if (test_leaf(leaves[BvhNode::leaf_index"),
-        (134, 152, "node", "} else {"),
-        (153, 159, "pop", "do {"),
-    ]),
+    "traverse_branched_from<": ("src/kernel/stack_traversal.hpp", "bool traverse_branched_from(", [
+        ("setup", None), ("node", "for (;;) {"), ("leaf", "if (reached_leaf && leaves.test"),
+        ("pop", "if (!pop_live(stack, sp, 0")]),
+    "traverse_branched<": ("src/kernel/stack_traversal.hpp", "bool traverse_branched(", [("setup", None)]),
+    "traverse_branchless<": ("src/kernel/stack_traversal.hpp", "bool traverse_branchless(", [
+        ("setup", None), ("node", "for (;;) {"), ("leaf", "if constexpr (Traits::kGaps) {"),
+        ("pop", "if (!pop_live(stack, sp, bottom")]),
+    "kd_traverse_rec<": ("src/kdtree/kd_traversal.hpp", "bool kd_traverse_rec(", [
+        ("setup", None), ("node", "for (;;) {"), ("leaf", "if (leaves.test(n, mem, r, q, c)) return true;"),
+        ("pop", "// Continue with the node")]),
+    "traverse_bvh<": ("src/bvh/bvh_kernels.inl", "bool traverse_bvh(", [
+        ("setup", None), ("node", "for (;;) {"), ("leaf", "if (test_leaf(leaves[BvhNode::leaf_index"),
+        ("node", "} else {"), ("pop", "do {")]),
 }
+
+
+def resolve_line_rules(root):
+    """LINE_RULES as {function: (file, [(first, last, category)])}, 1-based inclusive lines."""
+    resolved = {}
+    for fn, (path, anchor, steps) in LINE_RULES.items():
+        lines = open(os.path.join(root, path)).read().split("\n")
+        named = [i for i, line in enumerate(lines) if anchor in line]
+        if not named:
+            sys.exit(f"step_costs.py: {path} no longer has '{anchor}'; update LINE_RULES")
+        starts, pos = [named[0] - 1], named[0] + 1
+        for cat, marker in steps[1:]:
+            found = next((i for i in range(pos, len(lines)) if marker in lines[i]), None)
+            if found is None:
+                sys.exit(f"step_costs.py: {path} no longer reads '{marker}' after '{anchor}' ({fn} {cat}); "
+                         f"update LINE_RULES")
+            starts.append(found)
+            pos = found + 1
+        end = next(i for i in range(pos, len(lines)) if lines[i] == "}")
+        bounds = starts + [end + 1]
+        resolved[fn] = (path, [(bounds[k] + 1, bounds[k + 1], steps[k][0]) for k in range(len(steps))])
+    return resolved
+
 
 # Functions whose instructions belong to one step wherever they are inlined. A chain of inlined
 # functions is read from the innermost frame out; the first frame named here (or by LINE_RULES)
@@ -143,24 +155,18 @@ GENERIC_FILES = ("include/cellrt/vec.hpp", "include/cellrt/box.hpp", "include/ce
                  "kd_node.hpp", "bih_node.hpp", "bvh_node.hpp", "/usr/")
 
 
-def check_line_rules(root):
-    for fn, (path, ranges) in LINE_RULES.items():
-        lines = open(os.path.join(root, path)).read().split("\n")
-        for first, last, cat, marker in ranges:
-            if marker not in lines[first - 1]:
-                sys.exit(f"step_costs.py: {path}:{first} no longer reads '{marker}' (rule for {fn} {cat}); "
-                         f"update LINE_RULES")
+RULES = {}  # resolve_line_rules(ROOT), once the script runs
 
 
-def classify_chain(chain):
+def classify_chain(chain, rules=RULES):
     """chain: [(function, file, line)] innermost first. Returns (category, reason)."""
     for fn, _, _ in chain:
         if any(t in fn for t in TRIANGLE):
             return "triangle", fn
     for fn, path, line in chain:
-        for key, (rule_path, ranges) in LINE_RULES.items():
+        for key, (rule_path, ranges) in rules.items():
             if key in fn and path.endswith(rule_path):
-                for first, last, cat, _ in ranges:
+                for first, last, cat in ranges:
                     if first <= line <= last:
                         return cat, f"{rule_path}:{line}"
                 return "other", f"{rule_path}:{line} (no range)"
@@ -572,7 +578,7 @@ def main():
         return
     if not o.json:
         ap.error("--json is required")
-    check_line_rules(ROOT)
+    RULES.update(resolve_line_rules(ROOT))
     os.makedirs(o.work, exist_ok=True)
     todo = [(c, s, r) for r in o.rays for s in o.scenes for c in o.configs]
     results = []

@@ -154,6 +154,14 @@ TEST(Builtin, BadSpecsAreNamed) {
     EXPECT_EQ(error_of("builtin:city?tris=99"), "builtin:city?tris=99: 'tris' must lie in [100, 100000000]");
     EXPECT_EQ(error_of("builtin:city?tris=100000001"),
               "builtin:city?tris=100000001: 'tris' must lie in [100, 100000000]");
+    // Counts beyond 64 bits are out of range, refused before anything is allocated.
+    EXPECT_EQ(error_of("builtin:city?tris=99999999999999999999999"),
+              "builtin:city?tris=99999999999999999999999: 'tris' must lie in [100, 100000000]");
+    EXPECT_EQ(error_of("builtin:city?tris=1e9"),
+              "builtin:city?tris=1e9: 'tris' must be an unsigned integer, got '1e9'");
+    EXPECT_EQ(error_of("builtin:forest?seed=18446744073709551616"),
+              "builtin:forest?seed=18446744073709551616: 'seed' must lie in [0, 18446744073709551615]");
+    EXPECT_EQ(make_builtin_scene("builtin:spheres?tris=100&seed=18446744073709551615").name, "spheres");
 }
 
 // ---------------------------------------------------------------------------------------------

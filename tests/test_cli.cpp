@@ -103,6 +103,8 @@ TEST(Cli, SameImageForEveryPath) {
             {"bih_branched", {"--accel", "bih", "--traversal", "branched", "--packet", "1"}},
             {"kd_portable", {"--accel", "kd", "--simd", "portable", "--packet", "7"}},
             {"brute_auto", {"--accel", "brute", "--packet", "8"}},
+            {"bvh", {"--accel", "bvh", "--packet", "4"}},
+            {"routed", {"--accel", "auto", "--threads", "2"}},
         };
         for (const auto& [name, extra] : paths) {
             const Image img = render(name, extra);
@@ -182,6 +184,103 @@ TEST(Cli, NamesTheOptionAtFault) {
         EXPECT_EQ(text, "cellrt: error: " + message + "\n");
         EXPECT_FALSE(fs::exists(out));
     }
+}
+
+// The error output of the program run with `args` and its exit status.
+std::pair<std::string, int> run_for_error(const std::vector<std::string>& args, const fs::path& dir) {
+    const std::string errors = (dir / "errors.txt").string();
+    std::vector<std::string> all{CELLRT_CLI};
+    all.insert(all.end(), args.begin(), args.end());
+    const int status = wait_exit(spawn(all, errors));
+    std::ifstream in(errors);
+    return {std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}, status};
+}
+
+// Every bad input found by mutating files as a broken exporter might, and every size beyond the
+// limits, reaches the program's error path: one line naming the file or option, status 1 (never
+// std::terminate's 134, nor an out-of-memory kill).
+TEST(Cli, BadInputIsOneLineAndStatusOne) {
+    TempDir dir;
+    const std::string out = (dir.path / "x.png").string();
+    std::ofstream(dir.path / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    auto view = [&](const std::string& name, const std::string& fov) {
+        const std::string path = (dir.path / name).string();
+        std::ofstream(path) << "{\"mesh\": \"tri.obj\",\n \"camera\": {\"position\": [0.5, 0.5, 3], \"look_at\": [0.5, "
+                               "0.5, 0], \"up\": [0, 1, 0],\n  \"fov_y_deg\": "
+                            << fov
+                            << "},\n \"light\": {\"position\": [0, 5, 5]}, \"image\": {\"width\": 8, \"height\": 8}}\n";
+        return path;
+    };
+    const std::string over = view("over.json", "1e309"), under = view("under.json", "-1e309");
+    const std::string huge_ply = (dir.path / "huge.ply").string();
+    std::ofstream(huge_ply) << "ply\nformat ascii 1.0\nelement vertex 99999999999999999999\n";
+    const std::string huge_index = (dir.path / "index.obj").string();
+    std::ofstream(huge_index) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 99999999999999999999\n";
+    const std::string long_name = (dir.path / (std::string(300, 'a') + ".obj")).string();
+    const std::string spheres = "builtin:spheres?tris=100";
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+        {{"info", over}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
+        {{"render", over, "-o", out}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
+        {{"render", under, "-o", out}, under + ":3: invalid JSON: number overflow parsing '-1e309'"},
+        {{"info", huge_ply}, huge_ply + ":3: element count 99999999999999999999 is out of range (at most "
+                                        "18446744073709551615)"},
+        {{"info", huge_index}, huge_index + ":4: face index 99999999999999999999 is out of range"},
+        {{"info", long_name}, long_name + ": cannot look the file up: File name too long"},
+        {{"info", "builtin:city?tris=99999999999999999999999"},
+         "builtin:city?tris=99999999999999999999999: 'tris' must lie in [100, 100000000]"},
+        {{"render", spheres, "--size", "4294967297x10", "-o", out},
+         "--size '4294967297x10' must have both sides in [1, 65536]"},
+        {{"render", spheres, "--size", "20000x20000", "-o", out},
+         "--size '20000x20000' has 400000000 pixels, more than the largest image's 268435456"},
+        {{"render", spheres, "--threads", "100000", "-o", out}, "--threads 100000 must lie in [0, 1024]"},
+        {{"render", spheres, "--threads", "4000000000", "-o", out}, "--threads 4000000000 must lie in [0, 1024]"},
+        {{"info", spheres, "--accel", "kd", "--threads", "2000"}, "--threads 2000 must lie in [0, 1024]"},
+        {{"cache-study", spheres, "--threads", "5000", "--out", (dir.path / "study").string()},
+         "--threads 5000 must lie in [0, 1024]"},
+    };
+    for (const auto& [args, message] : cases) {
+        const auto [text, status] = run_for_error(args, dir.path);
+        EXPECT_EQ(status, 1) << args[0] << " " << args[1];
+        EXPECT_EQ(text, "cellrt: error: " + message + "\n");
+        EXPECT_FALSE(fs::exists(out));
+    }
+}
+
+// An exception thrown on a render worker (here Embree refusing rays beyond its range, from a camera
+// far away) ends the program on its error path under either dispatch mode.
+TEST(Cli, AnErrorOnARenderWorkerIsTheProgramsError) {
+    TempDir dir;
+    std::ofstream(dir.path / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    const std::string far = (dir.path / "far.json").string();
+    std::ofstream(far) << R"({"mesh": "tri.obj",
+        "camera": {"position": [1e19, 0, 0], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 45},
+        "light": {"position": [0, 5, 5]}, "image": {"width": 16, "height": 16}})";
+    const std::string out = (dir.path / "x.png").string();
+    if (run_for_error({"info", "--params", "embree"}, dir.path).second != 0) GTEST_SKIP() << "built without Embree";
+    for (const std::string dispatch : {"pull", "mailbox"}) {
+        const auto [text, code] = run_for_error(
+            {"render", far, "--accel", "embree", "--threads", "2", "--packet", "4", "--dispatch", dispatch, "-o", out},
+            dir.path);
+        EXPECT_EQ(code, 1) << dispatch;
+        EXPECT_EQ(text, "cellrt: error: embree: ray 0 of the batch has an origin or direction component beyond "
+                        "+-1.844e+18, outside Embree's range\n")
+            << dispatch;
+        EXPECT_FALSE(fs::exists(out));
+    }
+}
+
+// A scene named after a file whose name is not UTF-8 still gets its JSON report (nlohmann::json
+// would throw on the bytes once the render is done); they become U+FFFD.
+TEST(Cli, StatsOfAFileNamedInAnyBytes) {
+    TempDir dir;
+    const std::string mesh = (dir.path / "\xff\xfe.obj").string(), stats = (dir.path / "stats.json").string();
+    std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    const auto [text, status] =
+        run_for_error({"render", mesh, "--size", "8x8", "-o", (dir.path / "x.png").string(), "--stats", stats}, dir.path);
+    EXPECT_EQ(status, 0) << text;
+    std::ifstream in(stats);
+    const std::string json{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    EXPECT_NE(json.find("\"scene\": \"\xef\xbf\xbd\xef\xbf\xbd\""), std::string::npos) << json.substr(0, 200);
 }
 
 }  // namespace

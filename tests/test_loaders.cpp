@@ -133,6 +133,9 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {"v nan 0 0\n", ":1: vertex coordinate 'nan' is not finite"},
         {"v 0 -inf 0\n", ":1: vertex coordinate '-inf' is not finite"},
         {"v 0 0 1e39\n", ":1: vertex coordinate '1e39' is not finite"},
+        {"v 1e309 0 0\n", ":1: vertex coordinate '1e309' is not finite"},
+        {"v 0 -1e309 0\n", ":1: vertex coordinate '-1e309' is not finite"},
+        {"v 0 0 0 1e309\n", ":1: vertex coordinate '1e309' is not finite"},
         {kSquareVertices + "f 1 2\n", ":5: face needs at least three vertices, has 2"},
         {kSquareVertices + "f\n", ":5: face needs at least three vertices, has 0"},
         {kSquareVertices + "f 1 2 x\n", ":5: malformed face index 'x'"},
@@ -142,6 +145,12 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {kSquareVertices + "f 1 2 3\nf 1 2 6\nv 0 0 1\n", ":6: face index 6 is out of range (the file has 5 vertices)"},
         {kSquareVertices + "f 1 2 3\r\nf 2 3 9\r\n", ":6: face index 9 is out of range (the file has 4 vertices)"},
         {kSquareVertices + "f -5 -2 -1\nv 0 0 1\n", ":5: face index -5 is out of range (the file has 5 vertices)"},
+        {kSquareVertices + "f 1 2 99999999999999999999\n", ":5: face index 99999999999999999999 is out of range"},
+        {kSquareVertices + "f -99999999999999999999/1 1 2\n", ":5: face index -99999999999999999999 is out of range"},
+        {kSquareVertices + "f 1 2 9223372036854775807\n",
+         ":5: face index 9223372036854775807 is out of range (the file has 4 vertices)"},
+        {kSquareVertices + "f -9223372036854775808 1 2\n",
+         ":5: face index -9223372036854775808 is out of range (the file has 4 vertices)"},
     };
     for (const Case& c : cases) {
         const std::string path = write("bad.obj", c.text);
@@ -355,6 +364,10 @@ TEST_F(LoaderTest, PlyMalformedHeaderNamesFileAndLine) {
                                                        "integer"},
         {"ply\nformat ascii 1.0\nelement vertex\n", ":3: expected 'element NAME COUNT' with COUNT a non-negative "
                                                     "integer"},
+        {"ply\nformat ascii 1.0\nelement vertex 18446744073709551616\n",
+         ":3: element count 18446744073709551616 is out of range (at most 18446744073709551615)"},
+        {"ply\nformat ascii 1.0\nelement vertex 1e309\n", ":3: expected 'element NAME COUNT' with COUNT a "
+                                                          "non-negative integer"},
         {"ply\nformat ascii 1.0\nproperty float x\n", ":3: property before any element"},
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float16 x\n",
          ":4: unknown property type 'float16' (expected char, uchar, short, ushort, int, uint, float, double or int8 "
@@ -414,6 +427,12 @@ TEST_F(LoaderTest, PlyMalformedAsciiBodyNamesFileAndLine) {
         {"0 0 0\n1 0 0\n1 1 0\n3 0 1 99999999999 0\n", ":14: value 99999999999 is out of range for int"},
         {"0 0 0\nnan 0 0\n1 1 0\n3 0 1 2 0\n", ":12: vertex coordinate is not finite (as a float)"},
         {"0 0 0\n1 0 0\n1 1 1e39\n3 0 1 2 0\n", ":13: value 1e39 is out of range for float"},
+        {"0 0 0\n1 0 0\n1 1 1e309\n3 0 1 2 0\n", ":13: value 1e309 is out of range for float"},
+        {"0 0 0\n-1e309 0 0\n1 1 0\n3 0 1 2 0\n", ":12: value -1e309 is out of range for float"},
+        {"0 0 0\n1 0 0\n1 1 0\n3 0 1 99999999999999999999 0\n",
+         ":14: value 99999999999999999999 is out of range for int"},
+        {"0 0 0\n1 0 0\n1 1 0\n99999999999999999999 0 1 2 0\n",
+         ":14: value 99999999999999999999 is out of range for uchar"},
         {"0 0 0\n1 0 0\n1 1 0\n3 0 1 3 0\n", ":14: vertex index 3 is out of range (the file has 3 vertices)"},
         {"0 0 0\n1 0 0\n1 1 0\n3 0 -1 2 0\n", ":14: vertex index -1 is out of range (the file has 3 vertices)"},
         {"0 0 0\n1 0 0\n1 1 0\n2 0 1 0\n", ":14: face needs at least three vertices, has 2"},
@@ -479,6 +498,33 @@ TEST_F(LoaderTest, PlyHugeCountsInAShortFileAreTruncationNotExhaustion) {
                                                    kXyz + "end_header\n");
     EXPECT_EQ(error_of([&] { load_ply(path); }),
               path + ": vertex 0: unexpected end of file (the binary data is truncated)");
+    const std::string ascii = write("huge_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 18446744073709551615\n" +
+                                                          kXyz + "end_header\n0 0 0\n");
+    EXPECT_EQ(error_of([&] { load_ply(ascii); }),
+              ascii + ":9: unexpected end of file: element 'vertex' has 18446744073709551615 records, the file ends "
+                      "after 1");
+    // A list of 2^32 - 1 corners in a face of a few bytes.
+    std::string list = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n" + kXyz +
+                       "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+    for (int i = 0; i < 9; ++i) put<float>(list, 0.f, Endian::Little);
+    put<std::uint32_t>(list, 0xffffffffu, Endian::Little);
+    for (int i = 0; i < 3; ++i) put<std::int32_t>(list, i, Endian::Little);
+    const std::string corners = write("corners.ply", list);
+    EXPECT_EQ(error_of([&] { load_ply(corners); }),
+              corners + ": face 0: unexpected end of file (the binary data is truncated)");
+}
+
+// Numbers beyond a double's range in a float64 property, as text.
+TEST_F(LoaderTest, PlyDoublesBeyondTheirRangeAreRefused) {
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                               "property double z\nend_header\n";
+    for (const std::string bad : {"1e309", "-1e309", "1e99999"}) {
+        const std::string path = write("d.ply", header + "0 0 0\n0 " + bad + " 0\n0 0 0\n");
+        EXPECT_EQ(error_of([&] { load_ply(path); }), path + ":9: value " + bad + " is out of range for double");
+    }
+    // Within double's range but beyond float's: a coordinate cellrt cannot hold.
+    const std::string path = write("d.ply", header + "0 0 0\n0 1e300 0\n0 0 0\n");
+    EXPECT_EQ(error_of([&] { load_ply(path); }), path + ":9: vertex coordinate is not finite (as a float)");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -513,10 +559,79 @@ TEST_F(LoaderTest, ViewFileGivesMeshCameraLightAndSize) {
 
 TEST_F(LoaderTest, ViewFileInvalidJsonIsNamed) {
     const std::string path = write("bad.json", R"({"mesh": "tri.obj", "camera": )");
-    const std::string message = error_of([&] { load_view_file(path); });
-    EXPECT_EQ(message.rfind(path + ": invalid JSON: ", 0), 0u) << message;
+    EXPECT_EQ(error_of([&] { load_view_file(path); }),
+              path + ":1: invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', "
+                     "'{', or a literal");
     const std::string array = write("array.json", "[1, 2]");
     EXPECT_EQ(error_of([&] { load_view_file(array); }), array + ": a view file must be a JSON object");
+    const std::string late =
+        write("late.json", "{\n  \"mesh\": \"tri.obj\",\n  // a comment\n  \"camera\": [1,, 2]\n}\n");
+    EXPECT_EQ(error_of([&] { load_view_file(late); }),
+              late + ":4: invalid JSON: syntax error while parsing value - unexpected ','; expected '[', '{', or a "
+                     "literal");
+    const std::string utf8 = write("utf8.json", "{\n\"name\": \"\xff\"}");
+    const std::string message = error_of([&] { load_view_file(utf8); });
+    EXPECT_EQ(message.rfind(utf8 + ":2: invalid JSON: syntax error while parsing value - invalid string: ill-formed "
+                                   "UTF-8 byte",
+                            0),
+              0u)
+        << message;
+}
+
+// A number beyond a double's range is the parser's error (nlohmann's out_of_range, not a parse_error),
+// named with the file and line like any other; integers beyond 64 bits are numbers, not integers.
+TEST_F(LoaderTest, ViewFileNumbersBeyondTheirRangeAreNamed) {
+    write("tri.obj", kTriangleObj);
+    const std::string doc = view_doc().dump(1);  // a value a line
+    struct Case {
+        std::string from, to, message;  // LINE: the line of `from`
+    };
+    const std::vector<Case> cases{
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e309", ":LINE: invalid JSON: number overflow parsing '1e309'"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": -1e309", ":LINE: invalid JSON: number overflow parsing '-1e309'"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1" + std::string(400, '0'),
+         ":LINE: invalid JSON: number overflow parsing '1" + std::string(400, '0') + "'"},
+        {"\"height\": 32", "\"height\": 32e999", ":LINE: invalid JSON: number overflow parsing '32e999'"},
+        {"\"width\": 64", "\"width\": 100000000000000000000000",
+         ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"width\": 64", "\"width\": 18446744073709551615", ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"width\": 64", "\"width\": -9223372036854775809", ": field 'image.width' must be an integer in [1, 65536]"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e-400", ": camera fov_y_deg = 0.000000 must lie in (0, 180)"},
+    };
+    for (const Case& c : cases) {
+        std::string text = doc;
+        const std::size_t at = text.find(c.from);
+        ASSERT_NE(at, std::string::npos) << text;
+        text.replace(at, c.from.size(), c.to);
+        std::string message = c.message;
+        if (message.starts_with(":LINE:"))
+            message.replace(1, 4, std::to_string(1 + std::count(text.begin(), text.begin() + at, '\n')));
+        const std::string path = write("view.json", text);
+        EXPECT_EQ(error_of([&] { load_view_file(path); }), path + message) << c.to;
+        EXPECT_EQ(error_of([&] { load_scene(path); }), path + message) << c.to;
+    }
+}
+
+// An image too large to allocate is refused, though each side alone is allowed.
+TEST_F(LoaderTest, ViewFileImageOfTooManyPixelsIsRefused) {
+    write("tri.obj", kTriangleObj);
+    json doc = view_doc();
+    doc["image"] = {{"width", 65536}, {"height", 65536}};
+    const std::string path = write("view.json", doc.dump());
+    EXPECT_EQ(error_of([&] { load_view_file(path); }),
+              path + ": image size 65536x65536 has 4294967296 pixels, more than the largest image's 268435456");
+}
+
+// A path the system cannot look up (here a name longer than NAME_MAX) is an error naming it, not an
+// exception of std::filesystem.
+TEST_F(LoaderTest, PathsTheSystemCannotLookUpAreNamed) {
+    const std::string name = (dir_ / (std::string(300, 'a') + ".obj")).string();
+    EXPECT_EQ(error_of([&] { load_scene(name); }), name + ": cannot look the file up: File name too long");
+    json doc = view_doc();
+    doc["mesh"] = std::string(300, 'm') + ".obj";
+    const std::string view = write("view.json", doc.dump());
+    const std::string mesh = (dir_ / (std::string(300, 'm') + ".obj")).string();
+    EXPECT_EQ(error_of([&] { load_view_file(view); }), mesh + ": cannot look the file up: File name too long");
 }
 
 TEST_F(LoaderTest, ViewFileNamesEachMissingField) {

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -229,6 +230,31 @@ TEST(LocalStoreBudget, RefusesByHowMuch) {
     EXPECT_THROW(make_local_store_accelerator(scene.triangles, simd_packets, ok), Error);
     ok.node_cache.ways = 2;
     EXPECT_THROW(make_local_store_accelerator(scene.triangles, AccelConfig{"bih"}, ok), Error);
+}
+
+// Sizes whose products or sums would overflow are refused before they are computed.
+TEST(LocalStoreBudget, RefusesSizesBeyondTheModel) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=400");
+    auto error_of = [&](const LocalStoreConfig& c) {
+        try {
+            make_local_store_accelerator(scene.triangles, AccelConfig{"kd"}, c);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    LocalStoreConfig c;
+    c.budget_bytes = kMaxLocalStoreBytes + 1;
+    EXPECT_EQ(error_of(c), "local store: a budget of 4294967296 bytes is more than the model's 4294967295");
+    c.budget_bytes = std::numeric_limits<std::size_t>::max();
+    EXPECT_EQ(error_of(c), "local store: a budget of 18446744073709551615 bytes is more than the model's 4294967295");
+    c = LocalStoreConfig{};
+    constexpr std::size_t kMax = std::numeric_limits<std::size_t>::max();
+    for (const std::size_t rays : {kMax, kMax / 48 + 1, c.budget_bytes / 48 + 1}) {
+        c.batch_rays = rays;
+        EXPECT_EQ(error_of(c), "local store: a batch of " + std::to_string(rays) +
+                                   " rays and results needs more than the budget of 262144 bytes");
+    }
 }
 
 // Cache layouts and access modes every structure is traced through: small and large lines, direct-

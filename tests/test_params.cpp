@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -43,7 +44,7 @@ std::string documented_table(const std::string& doc, const std::string& kind) {
 // The documents' tables are the code's tables, row for row (`cellrt info --params KIND` prints the
 // same; rewrite a document's table from it when a parameter changes).
 TEST(Params, DocumentsPrintTheTablesThatValidate) {
-    std::vector<std::pair<std::string, std::string>> docs{{"kd", "KDTREE.md"}, {"bih", "BIH.md"}, {"bvh", "BVH.md"}};
+    std::vector<std::pair<std::string, std::string>> docs{{"kd", "KDTREE.md"}, {"bih", "BIH.md"}, {"bvh", "BVH.md"}, {"auto", "BVH.md"}};
     const auto kinds = accelerator_kinds();
     if (std::find(kinds.begin(), kinds.end(), "embree") != kinds.end()) docs.emplace_back("embree", "EMBREE.md");
     for (const auto& [kind, file] : docs)
@@ -108,6 +109,30 @@ TEST(Params, UnknownNamesAndValuesOutOfRangeAreRefused) {
     }
     EXPECT_THROW(accelerator_params("octree"), Error);
     EXPECT_THROW(accelerator_traversals("octree"), Error);
+    // Numbers beyond a double's or a long's range are out of the parameter's range, NaN is no number.
+    auto error_of = [](const std::string& kind, const std::string& name, const std::string& value) {
+        AccelConfig c;
+        c.kind = kind;
+        c.params = {{name, value}};
+        try {
+            make_accelerator(small_scene(), c);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    auto range_of = [](const std::string& kind, const std::string& name) {
+        for (const ParamSpec& p : accelerator_params(kind))
+            if (p.name == name) return param_range(p);
+        return std::string("(no parameter ") + name + ")";
+    };
+    for (const std::string v : {"1e309", "-1e309", "inf", "-inf"})
+        EXPECT_EQ(error_of("kd", "traversal_cost", v),
+                  "kd parameter traversal_cost=" + v + " is out of range " + range_of("kd", "traversal_cost"));
+    EXPECT_EQ(error_of("kd", "traversal_cost", "nan"), "kd parameter traversal_cost='nan' is not a number");
+    for (const std::string v : {"99999999999999999999", "-99999999999999999999", "9223372036854775807"})
+        EXPECT_EQ(error_of("bih", "leaf_size", v),
+                  "bih parameter leaf_size=" + v + " is out of range " + range_of("bih", "leaf_size"));
     EXPECT_THROW(make_accelerator(small_scene(), AccelConfig{"octree"}), Error);
 }
 
@@ -131,6 +156,26 @@ TEST(Params, BihSahCostsShapeTheTree) {
         return make_accelerator(small_scene(), c)->stats().tree.value().nodes;
     };
     EXPECT_LT(nodes("1"), nodes("1000"));
+}
+
+// An accelerator spec splits into its parts (checked later by make_accelerator); a parameter without
+// a name or an '=' is refused in the spec's words.
+TEST(Params, AcceleratorSpecsSplitOrAreRefused) {
+    const AccelConfig c = parse_accel_config("kd:rec+avx2@leaf_size=2,bins=64");
+    EXPECT_EQ(c.kind, "kd");
+    EXPECT_EQ(c.traversal, "rec");
+    EXPECT_EQ(c.simd, "avx2");
+    EXPECT_EQ(c.params, (std::map<std::string, std::string>{{"leaf_size", "2"}, {"bins", "64"}}));
+    for (const auto& [spec, part] : std::vector<std::pair<std::string, std::string>>{
+             {"kd@", ""}, {"kd@leaf_size", "leaf_size"}, {"kd@=2", "=2"}, {"kd@a=1,,b=2", ""}, {"kd@a=1,", ""}}) {
+        try {
+            parse_accel_config(spec);
+            ADD_FAILURE() << spec << " accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()), "accelerator parameter '" + part + "' must have the form NAME=VALUE");
+        }
+    }
+    EXPECT_THROW(make_accelerator(small_scene(), parse_accel_config("kd+avx2:rec")), Error);  // SIMD set 'avx2:rec'
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <unistd.h>
 
 #include "cellrt/accel.hpp"
@@ -9,6 +10,7 @@
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
+#include "error_of.hpp"
 
 namespace cellrt {
 namespace {
@@ -90,6 +92,45 @@ TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
     EXPECT_NO_THROW(write_image(img, path, true));
     EXPECT_THROW(write_image(img, (dir / "no" / "such" / "x.png").string(), false), Error);
     EXPECT_THROW(write_image(img, (dir / "x.bmp").string(), false), Error);
+    std::filesystem::remove_all(dir);
+}
+
+// Image sizes, as text and as numbers: both sides in [1, 65536], at most 2^28 pixels, refused in the
+// library's words before any pixel is allocated (render, read_pfm).
+TEST(ImageSize, ParsedStrictlyAndLimitedBeforeAllocation) {
+    using test::error_of;
+    EXPECT_EQ(parse_image_size("--size", "1920x1080"), (std::pair<int, int>{1920, 1080}));
+    EXPECT_EQ(parse_image_size("--size", "65536x4096"), (std::pair<int, int>{65536, 4096}));
+    EXPECT_EQ(parse_image_size("--size", "16384x16384"), (std::pair<int, int>{16384, 16384}));
+    for (const std::string bad : {"", "x", "10", "10x", "x10", " 10x10", "10x10 ", "+10x10", "10x+10", "10X10",
+                                  "10x10x1", "1e3x10", "10.5x10", "0x10.0"})
+        EXPECT_EQ(error_of([&] { parse_image_size("--size", bad); }),
+                  "--size '" + bad + "' must be WIDTHxHEIGHT (two whole numbers, e.g. 1920x1080)");
+    for (const std::string bad : {"0x5", "5x0", "-1x5", "65537x1", "4294967297x10", "99999999999999999999x1",
+                                  "-99999999999999999999x1"})
+        EXPECT_EQ(error_of([&] { parse_image_size("--size", bad); }),
+                  "--size '" + bad + "' must have both sides in [1, 65536]");
+    EXPECT_EQ(error_of([&] { parse_image_size("--size", "65536x65536"); }),
+              "--size '65536x65536' has 4294967296 pixels, more than the largest image's 268435456");
+    EXPECT_EQ(error_of([] { check_image_size(16385, 16384); }),
+              "image size 16385x16384 has 268451840 pixels, more than the largest image's 268435456");
+    EXPECT_EQ(error_of([] { check_image_size(-3, 4); }), "image size -3x4 must have both sides in [1, 65536]");
+
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=400");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    RenderOptions o;
+    o.width = o.height = 65536;
+    EXPECT_EQ(error_of([&] { render(scene, *accel, o); }),
+              "image size 65536x65536 has 4294967296 pixels, more than the largest image's 268435456");
+
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_test_size_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "huge.pfm").string();
+    std::ofstream(path, std::ios::binary) << "PF\n100000 100000\n-1.0\n";
+    EXPECT_EQ(error_of([&] { read_pfm(path); }),
+              path + ": image size 100000x100000 must have both sides in [1, 65536]");
+    std::ofstream(path, std::ios::binary) << "PF\n99999999999 2\n-1.0\n";
+    EXPECT_EQ(error_of([&] { read_pfm(path); }), path + ": not a little-endian RGB PFM file");
     std::filesystem::remove_all(dir);
 }
 

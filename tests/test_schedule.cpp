@@ -1,6 +1,7 @@
 // The packet scheduler: every dispatch mode, worker count and packet size gives the same image.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/timer.hpp"
+#include "error_of.hpp"
 #include "scenes.hpp"
 #include "schedule/worker_team.hpp"
 
@@ -180,20 +182,51 @@ TEST(Schedule, CancellationStopsEarlyAndReportsIt) {
 
 // In the library's words: the program puts its option's name in front.
 TEST(Schedule, RejectsBadSettings) {
-    auto error_of = [](auto&& f) {
-        try {
-            f();
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
+    using test::error_of;
     EXPECT_EQ(error_of([] { PacketGrid(16, 16, 0); }), "packet edge 0 must lie in [1, 256]");
     EXPECT_EQ(error_of([] { PacketGrid(16, 16, kMaxPacket + 1); }), "packet edge 257 must lie in [1, 256]");
     EXPECT_EQ(error_of([] { parse_dispatch("push"); }), "dispatch mode 'push' is not one of: pull, mailbox");
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
     std::vector<std::uint32_t> order(15);
     EXPECT_THROW(packet_order(PixelRect{0, 0, 4, 4}, order), Error);
+    // A worker count is refused before a thread or buffer is made for it.
+    ScheduleOptions many;
+    many.workers = kMaxWorkers + 1;
+    EXPECT_EQ(error_of([&] { worker_count(many); }), "1025 workers are more than the 1024 a frame may have");
+    Image image(16, 16);
+    const PacketTracer nothing = [](unsigned, const PixelRect&, std::span<Vec3>) {};
+    EXPECT_EQ(error_of([&] { run_packets(PacketGrid(16, 16, 4), many, image, nothing); }),
+              "1025 workers are more than the 1024 a frame may have");
+}
+
+// A packet that throws on any worker ends the frame under either dispatch mode: run_packets rethrows
+// its exception once the other workers have stopped (never std::terminate on a worker thread, never
+// a master waiting for a worker that is gone), and the next frame runs as usual.
+TEST(Schedule, APacketThatThrowsEndsTheFrameWithItsException) {
+    const PacketGrid grid(64, 64, 4);
+    for (const Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        for (const unsigned workers : {1u, 2u, 4u})
+            for (const std::size_t failing : {std::size_t(0), std::size_t(136), grid.count() - 1}) {
+                ScheduleOptions o;
+                o.dispatch = d;
+                o.workers = workers;
+                Image image(64, 64);
+                const PixelRect bad = grid.rect(failing);
+                try {
+                    run_packets(grid, o, image, [&](unsigned, const PixelRect& r, std::span<Vec3> c) {
+                        if (r.x0 == bad.x0 && r.y0 == bad.y0) throw Error("packet " + std::to_string(failing));
+                        std::fill(c.begin(), c.end(), Vec3(1.f));
+                    });
+                    ADD_FAILURE() << to_string(d) << ", " << workers << " workers: no exception";
+                } catch (const Error& e) {
+                    EXPECT_EQ(std::string(e.what()), "packet " + std::to_string(failing));
+                }
+                EXPECT_TRUE(run_packets(grid, o, image, [](unsigned, const PixelRect&, std::span<Vec3> c) {
+                    std::fill(c.begin(), c.end(), Vec3(2.f));
+                }));
+                EXPECT_TRUE(std::all_of(image.pixels.begin(), image.pixels.end(),
+                                        [](const Vec3& v) { return v == Vec3(2.f); }));
+            }
 }
 
 // The team behind both dispatch modes: every job index runs once per run, all at the same time (a
@@ -225,6 +258,29 @@ TEST(WorkerTeam, RunsEveryJobAtOnceOnKeptThreads) {
             EXPECT_EQ(ids[j], first[j]) << "job " << j << " moved to another thread";
         }
     }
+}
+
+// An exception from a job on a team thread reaches the caller once the other jobs are done (the first
+// thrown when several throw), and the team still runs.
+TEST(WorkerTeam, RethrowsAnExceptionFromAnyThread) {
+    detail::WorkerTeam team;
+    for (const unsigned failing : {1u, 3u}) {
+        std::atomic<unsigned> others{0};
+        try {
+            team.run(4, false, 0us, [&](unsigned j) {
+                if (j == failing) throw Error("job " + std::to_string(j) + " failed");
+                ++others;
+            });
+            ADD_FAILURE() << "job " << failing << ": no exception";
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()), "job " + std::to_string(failing) + " failed");
+        }
+        EXPECT_EQ(others.load(), 3u);
+    }
+    EXPECT_THROW(team.run(4, false, 0us, [](unsigned j) { throw Error("job " + std::to_string(j)); }), Error);
+    std::atomic<unsigned> ran{0};
+    team.run(4, false, 0us, [&](unsigned) { ++ran; });
+    EXPECT_EQ(ran.load(), 4u);
 }
 
 // An exception from job 0 reaches the caller once the other jobs are done, and the team still runs.

@@ -1,12 +1,21 @@
 // Every acceleration structure and traversal returns exactly the brute-force hits (closest hit: t,
 // triangle and barycentrics; any hit) on the ray suite of ray_suite.hpp, on built-in scenes, the
-// shared real scenes and a catalogue of degenerate inputs.
+// shared real scenes and a catalogue of degenerate inputs; and every path that traces rays takes
+// misuse (spans of different lengths, non-finite vertices, an empty scene, invalid rays, many threads
+// at once) as accelerator.hpp and accel.hpp say.
 #include <gtest/gtest.h>
+
+#include <barrier>
+#include <cmath>
+#include <functional>
+#include <thread>
 
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
+#include "accel/local_store_registry.hpp"
+#include "error_of.hpp"
 #include "ray_suite.hpp"
 #include "simd/isa.hpp"
 #include "structure_cases.hpp"
@@ -19,17 +28,18 @@ namespace {
 // the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
-                                    "bih:branched@split=sah", "bih+auto@split=sah"};
+                                    "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih"};
     for (detail::Isa isa : detail::available_isas())
         for (const char* kind : {"kd", "bih", "bvh"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;
 }
 const std::vector<std::string> kConfigs = exact_configs();
 
+// A GoogleTest name for a configuration: every character other than a letter or digit becomes '_'.
 std::string name_of(const std::string& config) {
     std::string s = config;
-    std::replace(s.begin(), s.end(), ':', '_');
-    for (const char c : {'+', '@', '='}) std::replace(s.begin(), s.end(), c, '_');
+    for (char& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
     return s;
 }
 
@@ -157,6 +167,236 @@ TEST(SimdSets, RefusedInTheLibrarysWords) {
                   0u)
             << unavailable;
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Misuse and bad input through every path that traces rays (docs/RELIABILITY.md)
+
+using test::error_of;
+
+// A way of building an accelerator over triangles, by name.
+struct Path {
+    std::string name;
+    std::function<std::unique_ptr<Accelerator>(std::span<const Triangle>)> make;
+};
+
+// Every path of this binary: the exact configurations above, brute force's loop and its SIMD sets,
+// Embree's traversals where Embree is built in and this processor runs them natively, and the
+// local-store model of each tree and traversal.
+std::vector<Path> every_path() {
+    std::vector<Path> out;
+    auto direct = [&](const std::string& spec) {
+        out.push_back({spec, [spec](std::span<const Triangle> tris) {
+                           return make_accelerator(tris, parse_accel_config(spec));
+                       }});
+    };
+    for (const std::string& c : kConfigs) direct(c);
+    direct("brute");
+    for (detail::Isa isa : detail::available_isas()) direct(std::string("brute+") + detail::to_string(isa));
+    const std::vector<std::string> kinds = accelerator_kinds();
+    if (std::find(kinds.begin(), kinds.end(), "embree") != kinds.end()) {
+        const Triangle tri{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+        for (const std::string& t : accelerator_traversals("embree")) {
+            try {
+                make_accelerator(std::span(&tri, 1), AccelConfig{"embree", t});
+            } catch (const Error&) {
+                continue;  // a packet width this processor does not run natively
+            }
+            direct("embree:" + t);
+        }
+    }
+    for (const std::string kind : {"kd", "bih"})
+        for (const std::string& t : accelerator_traversals(kind))
+            out.push_back({"local store " + kind + ":" + t, [kind, t](std::span<const Triangle> tris) {
+                               return std::unique_ptr<Accelerator>(
+                                   make_local_store_accelerator(tris, AccelConfig{kind, t}, LocalStoreConfig{}));
+                           }});
+    return out;
+}
+const std::vector<Path> kPaths = every_path();
+
+std::vector<std::string> path_names() {
+    std::vector<std::string> out;
+    for (const Path& p : kPaths) out.push_back(p.name);
+    return out;
+}
+
+class EveryPath : public testing::TestWithParam<std::string> {
+protected:
+    std::unique_ptr<Accelerator> make(std::span<const Triangle> tris) const {
+        for (const Path& p : kPaths)
+            if (p.name == GetParam()) return p.make(tris);
+        throw std::logic_error("no path " + GetParam());
+    }
+};
+
+// Spans of different lengths are refused before any ray is traced, in intersect and in occluded, with
+// fewer results and with more; an empty batch is no error.
+TEST_P(EveryPath, RefusesSpansOfDifferentLengths) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    const auto accel = make(scene.triangles);
+    const std::vector<Ray> rays(5, Ray{scene.camera.position, 0.f, scene.bounds().center() - scene.camera.position});
+    for (const std::size_t n : {4u, 6u, 0u}) {
+        std::vector<Hit> hits(n, Hit{1.f, 7u, 0.f, 0.f});
+        std::vector<std::uint8_t> occluded(n, 2);
+        EXPECT_EQ(error_of([&] { accel->intersect(rays, hits); }),
+                  "intersect: 5 rays but " + std::to_string(n) + " hits (the spans must have the same length)");
+        EXPECT_EQ(error_of([&] { accel->occluded(rays, occluded); }),
+                  "occluded: 5 rays but " + std::to_string(n) + " results (the spans must have the same length)");
+        EXPECT_EQ(hits, std::vector<Hit>(n, Hit{1.f, 7u, 0.f, 0.f})) << "results written before the refusal";
+        EXPECT_EQ(occluded, std::vector<std::uint8_t>(n, 2)) << "results written before the refusal";
+    }
+    EXPECT_EQ(error_of([&] { accel->intersect({}, {}); }), "no error");
+    EXPECT_EQ(error_of([&] { accel->occluded({}, {}); }), "no error");
+}
+
+// A NaN or infinite coordinate anywhere is refused by the registry, naming the triangle, before a
+// build can meet it.
+TEST_P(EveryPath, RefusesNonFiniteVertices) {
+    std::vector<Triangle> tris(4, Triangle{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}});
+    for (const float bad : {std::nanf(""), kInfinity, -kInfinity})
+        for (int corner = 0; corner < 3; ++corner) {
+            std::vector<Triangle> t = tris;
+            (corner == 0 ? t[2].v0 : corner == 1 ? t[2].v1 : t[2].v2)[corner] = bad;
+            EXPECT_EQ(error_of([&] { make(t); }), "triangle 2 has a non-finite coordinate") << bad << " " << corner;
+        }
+}
+
+// The rays of a batch that, were they valid, would hit the scene, mixed with valid ones, so that SIMD
+// packets meet invalid lanes beside valid ones: NaN or infinite origins and directions, a zero
+// direction, NaN bounds and tnear > tfar.
+std::vector<Ray> invalid_rays(const Scene& scene) {
+    const float nan = std::nanf("");
+    const Ray aimed{scene.camera.position, 0.f, scene.bounds().center() - scene.camera.position, kInfinity};
+    std::vector<std::function<void(Ray&)>> breaks;
+    for (int axis = 0; axis < 3; ++axis)
+        for (const float bad : {nan, kInfinity, -kInfinity}) {
+            breaks.push_back([=](Ray& r) { r.org[axis] = bad; });
+            breaks.push_back([=](Ray& r) { r.dir[axis] = bad; });
+        }
+    breaks.push_back([](Ray& r) { r.dir = Vec3{}; });
+    breaks.push_back([](Ray& r) { r.dir = Vec3{-0.f, -0.f, -0.f}; });
+    breaks.push_back([=](Ray& r) { r.tnear = nan; });
+    breaks.push_back([=](Ray& r) { r.tfar = nan; });
+    breaks.push_back([](Ray& r) { r.tnear = 2.f, r.tfar = 1.f; });
+    std::vector<Ray> out;
+    for (const auto& b : breaks) {
+        out.push_back(aimed);
+        b(out.back());
+    }
+    return out;
+}
+
+// Invalid rays hit nothing (ray.hpp), on every path, and among valid rays in one batch they change
+// nothing of the valid rays' answers (those of the valid rays traced alone: Embree's are its own).
+TEST_P(EveryPath, InvalidRaysHitNothing) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    const auto accel = make(scene.triangles);
+    const std::vector<Ray> invalid = invalid_rays(scene);
+    std::vector<Ray> rays, valid_rays;
+    std::vector<std::size_t> valid;  // where valid_rays[k] is in `rays`
+    const PinholeCamera camera(scene.camera, 8, 8);
+    for (std::size_t i = 0; i < invalid.size(); ++i) {
+        rays.push_back(invalid[i]);
+        for (std::size_t k = 0; k < i % 4; ++k) {  // 0 to 3 valid rays between invalid ones
+            valid.push_back(rays.size());
+            const int pixel = static_cast<int>(valid.size() % 64);
+            valid_rays.push_back(camera.primary(pixel % 8, pixel / 8));
+            rays.push_back(valid_rays.back());
+        }
+    }
+    std::vector<Hit> alone(valid_rays.size());
+    std::vector<std::uint8_t> alone_occluded(valid_rays.size());
+    accel->intersect(valid_rays, alone);
+    accel->occluded(valid_rays, alone_occluded);
+    std::vector<Hit> want(rays.size());
+    std::vector<std::uint8_t> want_occluded(rays.size(), 0);
+    for (std::size_t k = 0; k < valid.size(); ++k) {
+        want[valid[k]] = alone[k];
+        want_occluded[valid[k]] = alone_occluded[k];
+    }
+    std::vector<Hit> hits(rays.size(), Hit{1.f, 7u, 0.f, 0.f});
+    std::vector<std::uint8_t> occluded(rays.size(), 2);
+    accel->intersect(rays, hits);
+    accel->occluded(rays, occluded);
+    for (std::size_t i = 0; i < rays.size(); ++i)
+        EXPECT_TRUE(hits[i] == want[i] && occluded[i] == want_occluded[i])
+            << "ray " << i << " " << test::describe(rays[i]) << ": prim " << hits[i].prim << " occluded "
+            << int(occluded[i]) << ", want prim " << want[i].prim << " occluded " << int(want_occluded[i]);
+    EXPECT_GT(std::count(want_occluded.begin(), want_occluded.end(), 1), 0) << "the valid rays should hit";
+}
+
+// An empty scene builds on every path and every ray misses it (valid or not); its report is made.
+TEST_P(EveryPath, EmptySceneMissesEverything) {
+    const std::vector<Triangle> none;
+    const auto accel = make(none);
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    std::vector<Ray> rays = invalid_rays(scene);
+    const PinholeCamera camera(scene.camera, 8, 8);
+    for (int i = 0; i < 64; ++i) rays.push_back(camera.primary(i % 8, i / 8));
+    std::vector<Hit> hits(rays.size(), Hit{1.f, 7u, 0.f, 0.f});
+    std::vector<std::uint8_t> occluded(rays.size(), 2);
+    accel->intersect(rays, hits);
+    accel->occluded(rays, occluded);
+    EXPECT_EQ(hits, std::vector<Hit>(rays.size(), Hit{}));
+    EXPECT_EQ(occluded, std::vector<std::uint8_t>(rays.size(), 0));
+    const AccelStats stats = accel->stats();
+    EXPECT_EQ(stats.triangles, 0u);
+    EXPECT_FALSE(stats.figures().empty());
+}
+
+// Many threads calling intersect and occluded on one accelerator at once, each over the whole ray set
+// in batches, starting at different batches, get the answers of one thread, while one of them also
+// asks for stats() (accelerator.hpp).
+TEST_P(EveryPath, ConcurrentCallsGiveTheSingleThreadAnswers) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    const auto accel = make(scene.triangles);
+    test::RaySuiteOptions options;
+    options.random = options.inside = options.vertices = options.edges = 500;
+    options.axis_parallel = options.planes = 200;
+    const std::vector<Ray> rays = test::RaySuite(scene.triangles, options).rays();
+    constexpr std::size_t kBatch = 64;
+    const std::size_t batches = (rays.size() + kBatch - 1) / kBatch;
+    struct Answers {
+        std::vector<Hit> hits;
+        std::vector<std::uint8_t> occluded;
+        bool operator==(const Answers&) const = default;
+    };
+    auto trace = [&](Answers& a, std::size_t first_batch) {
+        a.hits.assign(rays.size(), Hit{});
+        a.occluded.assign(rays.size(), 0);
+        for (std::size_t k = 0; k < batches; ++k) {
+            const std::size_t i = (first_batch + k) % batches * kBatch, n = std::min(kBatch, rays.size() - i);
+            accel->intersect(std::span(rays).subspan(i, n), std::span(a.hits).subspan(i, n));
+            accel->occluded(std::span(rays).subspan(i, n), std::span(a.occluded).subspan(i, n));
+        }
+    };
+    Answers alone;
+    trace(alone, 0);
+    constexpr unsigned kThreads = 8;
+    std::vector<Answers> together(kThreads);
+    std::barrier start(kThreads);
+    std::vector<std::thread> threads;
+    for (unsigned t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            start.arrive_and_wait();
+            for (int round = 0; round < 3; ++round) {
+                trace(together[t], t * batches / kThreads + round);
+                if (t == 0) accel->stats();  // a report made while the others trace
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    for (unsigned t = 0; t < kThreads; ++t) EXPECT_TRUE(together[t] == alone) << "thread " << t;
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, EveryPath, testing::ValuesIn(path_names()),
+                         [](const auto& info) { return name_of(info.param); });
+
+// make_brute_force, public beside the registry, refuses non-finite vertices as make_accelerator does.
+TEST(BruteForceReference, RefusesNonFiniteVertices) {
+    const std::vector<Triangle> tris{{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, std::nanf(""), 0.f}}};
+    EXPECT_EQ(error_of([&] { make_brute_force(tris, AccelConfig{"brute"}); }),
+              "triangle 0 has a non-finite coordinate");
 }
 
 }  // namespace

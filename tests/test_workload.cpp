@@ -228,19 +228,21 @@ TEST(Sampling, CosineHemisphereStaysAboveTheSurface) {
 class RecordingAccelerator : public Accelerator {
 public:
     explicit RecordingAccelerator(const Accelerator& inner) : inner_(inner) {}
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        record(intersected, rays);
-        inner_.intersect(rays, hits, counters);
-    }
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded, TraversalCounters* counters) const override {
-        record(occlusion_tested, rays);
-        inner_.occluded(rays, occluded, counters);
-    }
     AccelStats stats() const override { return inner_.stats(); }
 
     mutable std::vector<std::vector<Ray>> intersected, occlusion_tested;
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        record(intersected, rays);
+        inner_.intersect(rays, hits, counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        record(occlusion_tested, rays);
+        inner_.occluded(rays, occluded, counters);
+    }
+
     void record(std::vector<std::vector<Ray>>& to, std::span<const Ray> rays) const {
         const std::lock_guard lock(mutex_);
         to.emplace_back(rays.begin(), rays.end());

@@ -11,7 +11,7 @@ import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-DOCS = {"kd": "KDTREE.md", "bih": "BIH.md", "bvh": "BVH.md", "embree": "EMBREE.md"}
+DOCS = {"kd": "KDTREE.md", "bih": "BIH.md", "bvh": "BVH.md", "auto": "BVH.md", "embree": "EMBREE.md"}
 
 
 def table(cellrt, kind):

@@ -12,8 +12,15 @@
 
 namespace cellrt {
 
-// Builds the structure `config.kind` over `triangles` (which must outlive the accelerator).
-// Throws cellrt::Error for an unknown kind, traversal or parameter, or a parameter out of range.
+// Builds the structure `config.kind` over `triangles`. Throws cellrt::Error for an unknown kind,
+// traversal or parameter, a parameter out of range, or a triangle with a NaN or infinite coordinate
+// (naming the first). An empty span is a scene every ray misses.
+//
+// What the accelerator keeps: brute force and the kd-tree read `triangles` itself (the kd-tree's
+// leaves index it) on every call, so it must outlive the accelerator, unchanged; the BIH keeps a
+// reordered copy, the wide BVH copies the triangles into its leaves and Embree into its own buffers,
+// so those need `triangles` only during the call. Code that may build any kind keeps the triangles
+// alive and unchanged as long as the accelerator. Hits name triangles by their index in `triangles`.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
 
 // An accelerator configuration written as one string, as the benchmarks and tests name them:

@@ -3,7 +3,13 @@
 // or a tile), so the one virtual dispatch is paid per batch, never per ray. The structures and their
 // registry are in cellrt/accel.hpp.
 //
-// Thread safety: intersect() and occluded() are const and may run concurrently on one accelerator.
+// Thread safety: intersect(), occluded() and stats() are const and may run at once from any number of
+// threads on one accelerator of any kind (each thread of the local-store model is a worker with a
+// local store of its own), and every call gets the answers it gets alone. Calls that run at once must
+// not share a TraversalCounters (it is summed unsynchronised) nor write overlapping result spans; a
+// local-store accelerator's statistics are read between traces (local_store.hpp). Destroying an
+// accelerator while a call runs on it is undefined, as for any object. What an accelerator keeps of
+// the triangles it was built over: cellrt/accel.hpp.
 #pragma once
 
 #include <cstdint>
@@ -79,15 +85,23 @@ class Accelerator {
 public:
     virtual ~Accelerator() = default;
 
-    // Closest hit of each ray under the hit rule of ray.hpp; hits.size() must equal rays.size().
-    virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits,
-                           TraversalCounters* counters = nullptr) const = 0;
+    // Closest hit of each ray under the hit rule of ray.hpp. Throws cellrt::Error when hits.size()
+    // differs from rays.size() (checked once per call, before any ray is traced).
+    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters = nullptr) const;
 
-    // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0.
-    virtual void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                          TraversalCounters* counters = nullptr) const = 0;
+    // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0. Throws
+    // cellrt::Error when occluded.size() differs from rays.size().
+    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                  TraversalCounters* counters = nullptr) const;
 
     virtual AccelStats stats() const = 0;
+
+private:
+    // What each structure implements, called by intersect() and occluded() with spans of equal length,
+    // so that no structure has to check them again.
+    virtual void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const = 0;
+    virtual void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                             TraversalCounters* counters) const = 0;
 };
 
 }  // namespace cellrt

@@ -8,7 +8,8 @@
 
 namespace cellrt {
 
+// make_accelerator with kind "brute" (cellrt/accel.hpp), its checks included: `triangles` must outlive
+// the accelerator, unchanged.
 std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangles, const AccelConfig& config);
-
 
 }  // namespace cellrt

@@ -9,7 +9,7 @@ namespace cellrt {
 class PinholeCamera {
 public:
     // Throws cellrt::Error for an impossible camera: zero-length view direction, up parallel to it,
-    // fov_y_deg outside (0, 180), non-finite values, or a non-positive image size.
+    // fov_y_deg outside (0, 180), non-finite values, or an image size check_image_size refuses.
     PinholeCamera(const Camera& camera, int width, int height);
 
     // Ray through the centre of pixel (px, py); py = 0 is the top row. Direction is normalised.

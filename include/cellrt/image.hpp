@@ -30,8 +30,18 @@ void write_image(const Image& image, const std::string& path, bool overwrite);
 // Reads a PFM written by write_image (for tests and comparisons).
 Image read_pfm(const std::string& path);
 
-// An image size written WIDTHxHEIGHT ("1920x1080"), both in [1, 65536]; throws cellrt::Error naming
-// `what` (an option, a field) otherwise.
+// The largest image: sides of at most kMaxImageSide pixels, and at most kMaxImagePixels pixels in all
+// (16384 x 16384, 3 GiB of float pixels; stb's PNG writer counts its buffers' bytes in an int).
+inline constexpr int kMaxImageSide = 65536;
+inline constexpr long long kMaxImagePixels = 1LL << 28;
+
+// Throws cellrt::Error "image size WxH ..." unless both sides lie in [1, kMaxImageSide] and the image
+// has at most kMaxImagePixels pixels. render() (through PinholeCamera) and read_pfm() check so before
+// they allocate an image's pixels.
+void check_image_size(int width, int height);
+
+// An image size written WIDTHxHEIGHT ("1920x1080"), two decimal numbers, checked by check_image_size;
+// throws cellrt::Error naming `what` (an option, a field) otherwise.
 std::pair<int, int> parse_image_size(const std::string& what, const std::string& text);
 
 // The sRGB transfer function applied to one linear channel, clamped to [0, 1].

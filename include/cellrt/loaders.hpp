@@ -1,5 +1,7 @@
 // File loaders. Each throws cellrt::Error whose message starts with "FILE:LINE:" (or "FILE:" for
-// whole-file problems, "FILE: field X" for view files) and says what was expected.
+// whole-file problems, "FILE: field X" for view files) and says what was expected; nothing else
+// escapes them (a number beyond its type's range, a path the system cannot look up) but
+// std::bad_alloc.
 #pragma once
 
 #include <string>

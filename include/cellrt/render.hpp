@@ -39,6 +39,11 @@ struct RenderStats {
     std::vector<WorkerLoad> workers;    // what each worker traced, and for how long
 };
 
+// Renders `scene` through `accel`, which must have been built over scene.triangles (shading reads the
+// triangle a hit names). Throws cellrt::Error for a size check_image_size refuses, a bad camera, packet
+// edge, worker count or AO sample count, when cancelled, or with the first exception a worker's packet
+// threw (the other workers stop at their next packet). render() may be called from several threads;
+// their frames are traced one after another (every frame runs on the process's one team of workers).
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,
              RenderStats* stats = nullptr);
 

@@ -61,7 +61,7 @@ void packet_order(const PixelRect& rect, std::span<std::uint32_t> order);
 
 struct ScheduleOptions {
     Dispatch dispatch = Dispatch::pull;
-    unsigned workers = 0;  // 0: all hardware threads
+    unsigned workers = 0;  // 0: all hardware threads; at most kMaxWorkers
     // Pin worker i to core i (under mailbox dispatch the master to core 0 and worker i to core i + 1;
     // Linux; ignored where unavailable). Worker 0 (pull) or the master (mailbox) is the calling thread.
     bool pin = false;
@@ -87,12 +87,19 @@ struct WorkerLoad {
     double finished_seconds = 0.0;  // when it found no packet left (or the frame cancelled)
 };
 
-// Number of worker threads `options` asks for.
+// The most workers a frame may have: more than any machine cellrt runs on has cores, few enough that
+// their threads and per-worker buffers are allocated without a second thought.
+inline constexpr unsigned kMaxWorkers = 1024;
+
+// Number of worker threads `options` asks for; throws cellrt::Error for more than kMaxWorkers.
 unsigned worker_count(const ScheduleOptions& options);
 
 // Traces every packet of `grid` into `image` (which must be grid.width x grid.height); when `loads`
 // is given, it receives one WorkerLoad per worker. Returns false when cancelled before all packets
-// were traced.
+// were traced. `trace` runs on every worker at once (on packets of its own) and must not call
+// run_packets: frames run one at a time on the process's one team of worker threads, so a second
+// caller waits for the first. The first exception `trace` throws on any worker stops the others at
+// their next packet and is rethrown here once all have stopped.
 bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
                  std::vector<WorkerLoad>* loads = nullptr);
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 #include <utility>
 
@@ -34,6 +35,10 @@ struct Triangle {
     friend bool operator==(const Triangle&, const Triangle&) = default;
 };
 static_assert(sizeof(Triangle) == 36);
+
+// Throws cellrt::Error "triangle I has a non-finite coordinate" for the first triangle with a NaN or
+// infinite coordinate: bounds, split planes and Embree's buffers have no meaning for one.
+void check_finite(std::span<const Triangle> triangles);
 
 // Per-ray constants of the test, computed once per ray (section 2 of the paper).
 struct WatertightRay {

@@ -64,7 +64,10 @@ struct RayBatch {
 
 // One packet's rays and what the accelerator answered, in buffers kept from packet to packet: a worker
 // holds one and traces packet after packet without allocating, for packets of up to `max_pixels`.
-// `scene` and `camera` must outlive it. Throws cellrt::Error for AO samples out of range.
+// `scene` and `camera` are referenced, not copied: they must outlive it. trace() writes the buffers,
+// so a workload is one thread's (one per worker); the accelerator it is given may be shared, and must
+// have been built over scene.triangles (the rays cast from a hit read the triangle it names). Throws
+// cellrt::Error for AO samples out of range.
 class PacketWorkload {
 public:
     PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,

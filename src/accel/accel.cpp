@@ -1,5 +1,6 @@
 // The registry: every structure this binary offers, by kind. The trees come from the one list
-// (structures.hpp); brute force, the wide BVH and Embree are backends of their own.
+// (structures.hpp); brute force, the wide BVH, the router over packets and the BVH (`auto`) and
+// Embree are backends of their own.
 #include "cellrt/accel.hpp"
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 
 #include "accel/local_store_registry.hpp"
 #include "accel/packet_table.hpp"
+#include "accel/routed_accelerator.hpp"
 #include "accel/structures.hpp"
 #include "accel/tree_accelerator.hpp"
 #include "accel/brute_force_listing.hpp"
@@ -49,6 +51,7 @@ std::vector<Entry> make_entries() {
                            return make_bvh(triangles, config, detail::bvh_kernels_for(config));
                        },
                        &bvh_params(), bvh_traversals()});
+    entries.push_back({"auto", &detail::make_routed, &detail::routed_params(), detail::routed_traversals()});
 #ifdef CELLRT_HAVE_EMBREE
     entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
 #endif
@@ -78,8 +81,12 @@ const ParamTable& accelerator_params(const std::string& kind) { return *entry(ki
 
 const std::vector<std::string>& accelerator_traversals(const std::string& kind) { return entry(kind).traversals; }
 
+// Non-finite vertices are refused here (and in make_local_store_accelerator), once for every kind and
+// before any build meets them.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config) {
-    return entry(config.kind).make(triangles, config);
+    const Entry& e = entry(config.kind);
+    check_finite(triangles);
+    return e.make(triangles, config);
 }
 
 std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,
@@ -96,6 +103,7 @@ std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<co
     if (config.simd != "off")
         throw Error("the local-store model runs the single-ray kernels, not SIMD packets (simd '" + config.simd +
                     "')");
+    check_finite(triangles);
     return e.local_store(triangles, config, local_store);
 }
 

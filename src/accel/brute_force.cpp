@@ -13,7 +13,17 @@ public:
     BruteForce(std::span<const Triangle> triangles, const detail::PacketKernels* packets)
         : triangles_(triangles), packets_(packets ? &packets->brute : nullptr), lanes_(packets ? packets->lanes : 0) {}
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+    AccelStats stats() const override {
+        AccelStats s;
+        s.name = "brute";
+        s.traversal = packets_ ? "packet" : "loop";
+        s.simd_lanes = lanes_;
+        s.triangles = triangles_.size();
+        return s;
+    }
+
+private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
         if (packets_) return packets_->closest(triangles_, rays, hits, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
@@ -28,8 +38,8 @@ public:
         count(rays.size(), counters);
     }
 
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
         if (packets_) return packets_->any(triangles_, rays, occluded, counters);
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& ray = rays[i];
@@ -46,16 +56,6 @@ public:
         count(rays.size(), counters);
     }
 
-    AccelStats stats() const override {
-        AccelStats s;
-        s.name = "brute";
-        s.traversal = packets_ ? "packet" : "loop";
-        s.simd_lanes = lanes_;
-        s.triangles = triangles_.size();
-        return s;
-    }
-
-private:
     void count(std::size_t n, TraversalCounters* counters) const {
         if (!counters) return;
         counters->rays += n;
@@ -82,6 +82,7 @@ std::unique_ptr<Accelerator> make_brute_force(std::span<const Triangle> triangle
     detail::ParamReader params(brute_force_params(), config, "brute");
     params.finish();
     detail::choose_traversal(brute_force_traversals(), config.traversal, "brute");
+    check_finite(triangles);  // again, for callers outside the registry
     return std::make_unique<BruteForce>(triangles, detail::packet_kernels_for(config));
 }
 

@@ -24,17 +24,6 @@ public:
           lanes_(packets ? packets->lanes : 0),
           structure_(build(triangles, config)) {}
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        if (packets_) return packets_->closest(structure_.view(), rays, hits, counters);
-        with_direct_kernel([&](auto& kernel) { closest_hits(structure_.bounds(), rays, hits, counters, kernel); });
-    }
-
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        if (packets_) return packets_->any(structure_.view(), rays, occluded, counters);
-        with_direct_kernel([&](auto& kernel) { any_hits(structure_.bounds(), rays, occluded, counters, kernel); });
-    }
-
     AccelStats stats() const override {
         AccelStats s;
         s.name = S::kName;
@@ -49,6 +38,17 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        if (packets_) return packets_->closest(structure_.view(), rays, hits, counters);
+        with_direct_kernel([&](auto& kernel) { closest_hits(structure_.bounds(), rays, hits, counters, kernel); });
+    }
+
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        if (packets_) return packets_->any(structure_.view(), rays, occluded, counters);
+        with_direct_kernel([&](auto& kernel) { any_hits(structure_.bounds(), rays, occluded, counters, kernel); });
+    }
+
     S build(std::span<const Triangle> triangles, const AccelConfig& config) {
         Timer timer;
         S s(triangles, config);

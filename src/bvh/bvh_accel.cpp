@@ -7,8 +7,6 @@
 namespace cellrt {
 namespace {
 
-const std::vector<std::string> kTraversals{"wide"};
-
 class BvhAccelerator final : public Accelerator {
 public:
     BvhAccelerator(std::span<const Triangle> triangles, const detail::BvhBuildOptions& options,
@@ -17,14 +15,6 @@ public:
         const Timer timer;
         tree_ = detail::build_bvh(triangles, options);
         build_seconds_ = timer.seconds();
-    }
-
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        kernels_.closest(tree_, rays, hits, counters);
-    }
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        kernels_.any(tree_, rays, occluded, counters);
     }
 
     AccelStats stats() const override {
@@ -53,6 +43,14 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        kernels_.closest(tree_, rays, hits, counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        kernels_.any(tree_, rays, occluded, counters);
+    }
+
     detail::BvhBuildOptions options_;
     const detail::BvhKernels& kernels_;
     std::size_t triangle_count_;
@@ -74,7 +72,12 @@ const ParamTable& bvh_params() {
     return table;
 }
 
-const std::vector<std::string>& bvh_traversals() { return kTraversals; }
+// A function's static, not a namespace-scope one: the registry copies the list when it is first used,
+// which may be during another unit's static initialisation (a test's list of configurations).
+const std::vector<std::string>& bvh_traversals() {
+    static const std::vector<std::string> names{"wide"};
+    return names;
+}
 
 std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config,
                                       const detail::BvhKernels& kernels) {
@@ -85,7 +88,7 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.traversal_cost = params.number("traversal_cost");
     options.intersection_cost = params.number("intersection_cost");
     params.finish();
-    detail::choose_traversal(kTraversals, config.traversal, "bvh");
+    detail::choose_traversal(bvh_traversals(), config.traversal, "bvh");
     return std::make_unique<BvhAccelerator>(triangles, options, kernels);
 }
 

@@ -51,10 +51,12 @@ private:
         double cost = 0.0;
     };
 
+    // Clamped as a float, before the conversion: a centroid at the box's far side gives `bins`, and
+    // where the extent is subnormal, bins / extent is inf and k inf or NaN, which no int holds.
     int bin_of(const Vec3& c, int axis, const Box3& cbox) const {
         const float extent = cbox.hi[axis] - cbox.lo[axis];
-        const int k = static_cast<int>((c[axis] - cbox.lo[axis]) * (static_cast<float>(o_.bins) / extent));
-        return std::clamp(k, 0, o_.bins - 1);
+        const float k = (c[axis] - cbox.lo[axis]) * (static_cast<float>(o_.bins) / extent);
+        return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(o_.bins - 1))) : 0;
     }
 
     // The cheapest binned SAH split of the node's triangles, or axis -1 when all centroids coincide.

@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -42,15 +41,6 @@ std::string encode_pfm(const Image& image) {
 
 }  // namespace
 
-std::pair<int, int> parse_image_size(const std::string& what, const std::string& text) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 || w > 65536 ||
-        h > 65536)
-        throw Error(what + " '" + text + "' must be WIDTHxHEIGHT with both in [1, 65536]");
-    return {w, h};
-}
-
 float linear_to_srgb(float linear) {
     const float c = std::clamp(linear, 0.f, 1.f);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
@@ -74,8 +64,12 @@ Image read_pfm(const std::string& path) {
     double scale = 0.0;
     in >> magic >> w >> h >> scale;
     in.get();
-    if (!in || magic != "PF" || w < 1 || h < 1 || scale >= 0.0)
-        throw Error(path + ": not a little-endian RGB PFM file");
+    if (!in || magic != "PF" || scale >= 0.0) throw Error(path + ": not a little-endian RGB PFM file");
+    try {
+        check_image_size(w, h);
+    } catch (const Error& e) {
+        throw Error(path + ": " + e.what());
+    }
     Image image(w, h);
     for (int y = h - 1; y >= 0; --y)
         in.read(reinterpret_cast<char*>(&image.at(0, y)), static_cast<std::streamsize>(sizeof(Vec3)) * w);

@@ -15,6 +15,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/timer.hpp"
 #include "kernel/param_reader.hpp"
+#include "kernel/subtree.hpp"
 
 namespace cellrt {
 namespace {
@@ -194,8 +195,7 @@ struct alignas(W * sizeof(int)) ValidMask {
     int lanes[W];
 };
 
-// Traversal names and their packet widths (1: one ray per call).
-const std::vector<std::string> kTraversals = {"single", "packet4", "packet8", "packet16"};
+// The packet widths of embree_traversals() (1: one ray per call).
 constexpr int kTraversalWidths[] = {1, 4, 8, 16};
 
 RTCBuildQuality parse_quality(const std::string& name) {
@@ -226,29 +226,6 @@ public:
         build_seconds_ = build.seconds();
     }
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        switch (options_.width) {
-            case 4: intersect_packets<4>(rays, hits); break;
-            case 8: intersect_packets<8>(rays, hits); break;
-            case 16: intersect_packets<16>(rays, hits); break;
-            default: intersect_single(rays, hits); break;
-        }
-        errors_.throw_if_failed("intersect");
-        if (counters) counters->rays += rays.size();
-    }
-
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        switch (options_.width) {
-            case 4: occluded_packets<4>(rays, occluded); break;
-            case 8: occluded_packets<8>(rays, occluded); break;
-            case 16: occluded_packets<16>(rays, occluded); break;
-            default: occluded_single(rays, occluded); break;
-        }
-        errors_.throw_if_failed("occluded");
-        if (counters) counters->rays += rays.size();
-    }
-
     AccelStats stats() const override {
         AccelStats s;
         s.name = "embree";
@@ -269,6 +246,29 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        switch (options_.width) {
+            case 4: intersect_packets<4>(rays, hits); break;
+            case 8: intersect_packets<8>(rays, hits); break;
+            case 16: intersect_packets<16>(rays, hits); break;
+            default: intersect_single(rays, hits); break;
+        }
+        errors_.throw_if_failed("intersect");
+        if (counters) counters->rays += rays.size();
+    }
+
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        switch (options_.width) {
+            case 4: occluded_packets<4>(rays, occluded); break;
+            case 8: occluded_packets<8>(rays, occluded); break;
+            case 16: occluded_packets<16>(rays, occluded); break;
+            default: occluded_single(rays, occluded); break;
+        }
+        errors_.throw_if_failed("occluded");
+        if (counters) counters->rays += rays.size();
+    }
+
     void create_device() {
         // Configuration files (.embree3 beside the program or in $HOME) are ignored, so that a
         // benchmark's yardstick does not depend on the user's home folder.
@@ -353,7 +353,7 @@ private:
         if (options_.threads == 0) {
             rtcCommitScene(scene_.get());
         } else {
-            tbb::task_arena arena(static_cast<int>(options_.threads));
+            tbb::task_arena arena(detail::build_concurrency(options_.threads));
             arena.execute([&] { rtcCommitScene(scene_.get()); });
         }
         errors_.throw_if_failed("build (rtcCommitScene)");
@@ -458,7 +458,11 @@ const ParamTable& embree_params() {
     return table;
 }
 
-const std::vector<std::string>& embree_traversals() { return kTraversals; }
+// A function's static, for the reason bvh_traversals() gives (bvh_accel.cpp).
+const std::vector<std::string>& embree_traversals() {
+    static const std::vector<std::string> names{"single", "packet4", "packet8", "packet16"};
+    return names;
+}
 
 std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, const AccelConfig& config) {
     detail::ParamReader params(embree_params(), config, "embree");
@@ -467,9 +471,10 @@ std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, co
     options.robust = params.boolean("robust");
     options.compact = params.boolean("compact");
     params.finish();
-    options.traversal = detail::choose_traversal(kTraversals, config.traversal, "embree");
-    options.width = kTraversalWidths[std::find(kTraversals.begin(), kTraversals.end(), options.traversal) -
-                                     kTraversals.begin()];
+    const std::vector<std::string>& traversals = embree_traversals();
+    options.traversal = detail::choose_traversal(traversals, config.traversal, "embree");
+    options.width = kTraversalWidths[std::find(traversals.begin(), traversals.end(), options.traversal) -
+                                     traversals.begin()];
     options.threads = config.threads;
     return std::make_unique<EmbreeAccel>(triangles, options);
 }

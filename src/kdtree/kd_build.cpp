@@ -333,7 +333,11 @@ private:
             const float lo = tight.lo[a], hi = tight.hi[a];
             if (!(lo < hi)) continue;
             const float scale = static_cast<float>(bins) / (hi - lo);
-            auto bin = [&](float x) { return std::clamp(static_cast<int>((x - lo) * scale), 0, bins - 1); };
+            // Where hi - lo is subnormal, scale is inf and the product inf or NaN, which no int holds.
+            auto bin = [&](float x) {
+                const float k = (x - lo) * scale;
+                return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(bins - 1))) : 0;
+            };
             std::fill(starts.begin(), starts.end(), 0u);
             std::fill(ends.begin(), ends.end(), 0u);
             for (const Ref& r : w.refs) {

@@ -1,7 +1,6 @@
 #include "param_reader.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -30,9 +29,10 @@ std::vector<std::string> table_names(const ParamTable& table) {
 ParamReader::ParamReader(const ParamTable& table, const AccelConfig& config, std::string structure)
     : table_(table), given_(config.params), structure_(std::move(structure)) {
     std::vector<std::string> unknown;
-    for (const auto& [name, value] : given_)
-        if (std::none_of(table_.begin(), table_.end(), [&](const ParamSpec& p) { return p.name == name; }))
-            unknown.push_back(name);
+    // Not a structured binding: clang before 16 cannot capture one in a lambda.
+    for (const auto& given : given_)
+        if (std::none_of(table_.begin(), table_.end(), [&](const ParamSpec& p) { return p.name == given.first; }))
+            unknown.push_back(given.first);
     if (unknown.empty()) return;
     const std::string takes = table_.empty() ? structure_ + " takes none" : structure_ + " takes: " +
                                                                                 join_names(table_names(table_));
@@ -59,11 +59,11 @@ double ParamReader::number(const std::string& name, const std::string* default_v
     const ParamSpec& p = spec(name, ParamType::number);
     const std::string& t = text(p, default_value);
     char* end = nullptr;
-    errno = 0;
     const double value = std::strtod(t.c_str(), &end);
-    if (t.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value))
+    if (t.empty() || *end != '\0' || std::isnan(value))
         throw Error(structure_ + " parameter " + name + "='" + t + "' is not a number");
-    if (value < p.min || value > p.max)
+    // Infinities, and numbers beyond a double's range (strtod makes them infinite), fail here too.
+    if (!(value >= p.min && value <= p.max))
         throw Error(structure_ + " parameter " + name + "=" + t + " is out of range " + param_range(p));
     return value;
 }
@@ -72,10 +72,10 @@ int ParamReader::integer(const std::string& name) {
     const ParamSpec& p = spec(name, ParamType::integer);
     const std::string& t = text(p, nullptr);
     char* end = nullptr;
-    errno = 0;
     const long value = std::strtol(t.c_str(), &end, 10);
-    if (t.empty() || *end != '\0' || errno == ERANGE)
+    if (t.empty() || *end != '\0')
         throw Error(structure_ + " parameter " + name + "='" + t + "' is not an integer");
+    // Beyond long's range strtol gives LONG_MIN or LONG_MAX, which no table's range includes.
     if (static_cast<double>(value) < p.min || static_cast<double>(value) > p.max)
         throw Error(structure_ + " parameter " + name + "=" + t + " is out of range " + param_range(p));
     return static_cast<int>(value);

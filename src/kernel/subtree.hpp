@@ -35,7 +35,7 @@ struct Subtree {
 // Threads a build may use: the user's count (0: all), never more than the machine has.
 inline int build_concurrency(unsigned requested) {
     const int cores = tbb::info::default_concurrency();
-    return requested == 0 ? cores : std::min(cores, static_cast<int>(requested));
+    return requested == 0 ? cores : static_cast<int>(std::min(static_cast<unsigned>(cores), requested));
 }
 
 // Checks an index against the `max` a node can encode; throws naming the structure otherwise.

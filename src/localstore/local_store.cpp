@@ -17,6 +17,13 @@ std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& c
     validate_cache_layout(config.node_cache, "node cache " + config.node_cache.to_string());
     validate_cache_layout(config.triangle_cache, "triangle cache " + config.triangle_cache.to_string());
     if (config.batch_rays == 0) throw Error("local store: a batch needs at least one ray");
+    // Checked before any product or sum below can overflow; the model's transfers count 32-bit bytes.
+    if (config.budget_bytes > kMaxLocalStoreBytes)
+        throw Error("local store: a budget of " + std::to_string(config.budget_bytes) + " bytes is more than the " +
+                    "model's " + std::to_string(kMaxLocalStoreBytes));
+    if (config.batch_rays > config.budget_bytes / (sizeof(Ray) + sizeof(Hit)))
+        throw Error("local store: a batch of " + std::to_string(config.batch_rays) + " rays and results needs more " +
+                    "than the budget of " + std::to_string(config.budget_bytes) + " bytes");
     auto cache = [](const char* name, const CacheLayout& l) {
         return LocalStoreAllocation{std::string(name) + " " + l.to_string(),
                                     l.capacity() + l.lines() * kDirectoryBytesPerLine};

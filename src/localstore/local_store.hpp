@@ -49,8 +49,12 @@ struct LocalStoreAllocation {
     std::size_t bytes;
 };
 
+// The largest budget the model takes: 4 GiB - 1, as its transfers count bytes in 32 bits.
+inline constexpr std::size_t kMaxLocalStoreBytes = 0xffff'ffff;
+
 // The allocations of `config` with a traversal stack of `stack_bytes`. Throws cellrt::Error when a
-// layout is invalid or the allocations exceed the budget, saying by how many bytes.
+// layout is invalid, the budget is over kMaxLocalStoreBytes or the allocations exceed it, saying by
+// how many bytes.
 std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& config, std::size_t stack_bytes);
 
 // Bytes of directory (tag and replacement state) the local store keeps per cache line.

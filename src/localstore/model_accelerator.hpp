@@ -83,19 +83,6 @@ public:
           allocations_(allocate_local_store(config, S::stack_bytes(traversal_))),
           workers_([this] { return WorkerStore(config_, built_->memory); }) {}
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        trace(rays.size(), sizeof(Hit), [&](std::size_t i, std::size_t n, auto& kernel) {
-            closest_hits(built_->structure.bounds(), rays.subspan(i, n), hits.subspan(i, n), counters, kernel);
-        });
-    }
-
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override {
-        trace(rays.size(), sizeof(std::uint8_t), [&](std::size_t i, std::size_t n, auto& kernel) {
-            any_hits(built_->structure.bounds(), rays.subspan(i, n), occluded.subspan(i, n), counters, kernel);
-        });
-    }
-
     AccelStats stats() const override {
         const LocalStoreConfig& c = config_;
         const S& structure = built_->structure;
@@ -139,6 +126,19 @@ public:
     }
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        trace(rays.size(), sizeof(Hit), [&](std::size_t i, std::size_t n, auto& kernel) {
+            closest_hits(built_->structure.bounds(), rays.subspan(i, n), hits.subspan(i, n), counters, kernel);
+        });
+    }
+
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        trace(rays.size(), sizeof(std::uint8_t), [&](std::size_t i, std::size_t n, auto& kernel) {
+            any_hits(built_->structure.bounds(), rays.subspan(i, n), occluded.subspan(i, n), counters, kernel);
+        });
+    }
+
     // Traces `count` rays on the calling thread's worker, one batch of at most batch_rays at a time:
     // `batch(first, n, kernel)` runs the batch loop over rays [first, first + n) with `kernel`.
     template <class Batch>

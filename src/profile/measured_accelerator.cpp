@@ -17,20 +17,21 @@ void MeasuredAccelerator::measure(Call&& call) const {
     counters_->count(call);
 }
 
-void MeasuredAccelerator::intersect(std::span<const Ray> rays, std::span<Hit> hits,
+void MeasuredAccelerator::do_intersect(std::span<const Ray> rays, std::span<Hit> hits,
                                     TraversalCounters* counters) const {
     measure([&] { inner_.intersect(rays, hits, counters); });
 }
 
-void MeasuredAccelerator::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                                   TraversalCounters* counters) const {
+void MeasuredAccelerator::do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                                      TraversalCounters* counters) const {
     measure([&] { inner_.occluded(rays, occluded, counters); });
 }
 
 EventCounts MeasuredAccelerator::counts() const { return counters_ ? counters_->read() : EventCounts{}; }
 
 std::vector<std::string> MeasuredAccelerator::callgrind_toggles() {
-    return {"cellrt::profile::MeasuredAccelerator::intersect(*", "cellrt::profile::MeasuredAccelerator::occluded(*"};
+    return {"cellrt::profile::MeasuredAccelerator::do_intersect(*",
+            "cellrt::profile::MeasuredAccelerator::do_occluded(*"};
 }
 
 }  // namespace cellrt::profile

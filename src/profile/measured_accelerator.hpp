@@ -25,9 +25,6 @@ public:
 
     MeasuredAccelerator(const Accelerator& inner, Counting counting) : inner_(inner), counting_(counting) {}
 
-    void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override;
-    void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                  TraversalCounters* counters) const override;
     AccelStats stats() const override { return inner_.stats(); }
 
     // The sums over all calls so far (hardware counting; zero before the first call).
@@ -37,6 +34,10 @@ public:
     static std::vector<std::string> callgrind_toggles();
 
 private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override;
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override;
+
     template <class Call>
     void measure(Call&& call) const;
 

@@ -1,6 +1,7 @@
 #include "cellrt/builtin.hpp"
 
 #include <charconv>
+#include <limits>
 #include <string_view>
 
 #include "builtin_generators.hpp"
@@ -26,11 +27,18 @@ constexpr Generator kGenerators[] = {
     {"spheres", "five tessellated spheres and a box on a ground plane", 4000, &detail::make_spheres},
 };
 
-std::uint64_t parse_unsigned(std::string_view value, const std::string& spec, std::string_view key) {
+// `value` as an unsigned integer in [min, max]; digits beyond 64 bits are a number out of that range,
+// not a malformed one.
+std::uint64_t parse_unsigned(std::string_view value, const std::string& spec, std::string_view key, std::uint64_t min,
+                             std::uint64_t max) {
     std::uint64_t v = 0;
     const auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-    if (value.empty() || ec != std::errc() || ptr != value.data() + value.size())
+    if (value.empty() || ptr != value.data() + value.size() ||
+        (ec != std::errc() && ec != std::errc::result_out_of_range))
         throw Error(spec + ": '" + std::string(key) + "' must be an unsigned integer, got '" + std::string(value) + "'");
+    if (ec != std::errc() || v < min || v > max)
+        throw Error(spec + ": '" + std::string(key) + "' must lie in [" + std::to_string(min) + ", " +
+                    std::to_string(max) + "]");
     return v;
 }
 
@@ -45,6 +53,7 @@ std::vector<BuiltinInfo> builtin_scenes() {
 std::string default_scene_spec() { return "builtin:city"; }
 
 Scene make_builtin_scene(const std::string& spec) {
+    if (spec.rfind("builtin:", 0) != 0) throw Error(spec + ": a built-in scene's spec starts with 'builtin:'");
     std::string_view rest = std::string_view(spec).substr(std::string_view("builtin:").size());
     const std::size_t q = rest.find('?');
     const std::string_view name = rest.substr(0, q);
@@ -67,11 +76,9 @@ Scene make_builtin_scene(const std::string& spec) {
         if (eq == std::string_view::npos) throw Error(spec + ": expected key=value, got '" + std::string(pair) + "'");
         const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
         if (key == "tris") {
-            params.tris = parse_unsigned(value, spec, key);
-            if (params.tris < 100 || params.tris > 100'000'000)
-                throw Error(spec + ": 'tris' must lie in [100, 100000000]");
+            params.tris = parse_unsigned(value, spec, key, 100, 100'000'000);
         } else if (key == "seed") {
-            params.seed = parse_unsigned(value, spec, key);
+            params.seed = parse_unsigned(value, spec, key, 0, std::numeric_limits<std::uint64_t>::max());
         } else {
             throw Error(spec + ": unknown key '" + std::string(key) + "' (known: tris, seed)");
         }

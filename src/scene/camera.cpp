@@ -4,12 +4,12 @@
 #include <numbers>
 
 #include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
 
 namespace cellrt {
 
 PinholeCamera::PinholeCamera(const Camera& camera, int width, int height) {
-    if (width < 1 || height < 1)
-        throw Error("image size " + std::to_string(width) + "x" + std::to_string(height) + " must be positive");
+    check_image_size(width, height);
     if (!is_finite(camera.position) || !is_finite(camera.look_at) || !is_finite(camera.up))
         throw Error("camera position, look_at and up must be finite");
     if (!(camera.fov_y_deg > 0.f && camera.fov_y_deg < 180.f))

@@ -79,8 +79,11 @@ private:
             const std::string_view pos = tok.substr(0, tok.find('/'));
             std::int64_t index = 0;
             const auto [ptr, ec] = std::from_chars(pos.data(), pos.data() + pos.size(), index);
-            if (ec != std::errc() || ptr != pos.data() + pos.size() || pos.empty())
+            if (ptr != pos.data() + pos.size() || pos.empty() ||
+                (ec != std::errc() && ec != std::errc::result_out_of_range))
                 fail("malformed face index '" + std::string(tok) + "'", line_);
+            if (ec == std::errc::result_out_of_range)  // beyond 64 bits: no file has that many vertices
+                fail("face index " + std::string(pos) + " is out of range", line_);
             if (index == 0) fail("face index 0 is invalid (OBJ indices start at 1)", line_);
             corners_.push_back({index, vertices_.size()});
         }

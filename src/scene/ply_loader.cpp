@@ -153,9 +153,11 @@ private:
         e.name = std::string(next_token(rest));
         const std::string_view count = next_token(rest);
         const auto [ptr, ec] = std::from_chars(count.data(), count.data() + count.size(), e.count);
-        if (e.name.empty() || count.empty() || ec != std::errc() || ptr != count.data() + count.size() ||
-            !next_token(rest).empty())
+        if (e.name.empty() || count.empty() || (ec != std::errc() && ec != std::errc::result_out_of_range) ||
+            ptr != count.data() + count.size() || !next_token(rest).empty())
             fail("expected 'element NAME COUNT' with COUNT a non-negative integer");
+        if (ec == std::errc::result_out_of_range)
+            fail("element count " + std::string(count) + " is out of range (at most 18446744073709551615)");
         for (const Element& other : header_.elements)
             if (other.name == e.name) fail("a second element '" + e.name + "'");
         e.line = line_;

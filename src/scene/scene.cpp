@@ -8,6 +8,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/files.hpp"
 #include "cellrt/loaders.hpp"
+#include "read_file.hpp"
 
 namespace cellrt {
 
@@ -33,13 +34,9 @@ void set_default_view(Scene& scene) {
 
 void validate_scene(const Scene& scene, const std::string& where) {
     if (scene.triangles.empty()) throw Error(where + ": the mesh has no triangles");
-    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
-        const Triangle& t = scene.triangles[i];
-        if (!is_finite(t.v0) || !is_finite(t.v1) || !is_finite(t.v2))
-            throw Error(where + ": triangle " + std::to_string(i) + " has a non-finite coordinate");
-    }
-    if (!is_finite(scene.light.position)) throw Error(where + ": the light position is not finite");
     try {
+        check_finite(scene.triangles);
+        if (!is_finite(scene.light.position)) throw Error("the light position is not finite");
         PinholeCamera(scene.camera, scene.width, scene.height);
     } catch (const Error& e) {
         throw Error(where + ": " + e.what());
@@ -55,7 +52,7 @@ std::vector<Triangle> load_mesh(const std::string& path) {
 
 Scene load_scene(const std::string& spec) {
     if (spec.rfind("builtin:", 0) == 0) return make_builtin_scene(spec);
-    if (!std::filesystem::exists(spec)) throw Error(spec + ": no such file");
+    if (!detail::file_exists(spec)) throw Error(spec + ": no such file");
     if (lower_extension(spec) == ".json") return load_view_file(spec);
     Scene scene;
     scene.name = std::filesystem::path(spec).stem().string();

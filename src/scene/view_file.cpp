@@ -1,9 +1,12 @@
 // View files: JSON with mesh, camera, light and image (shared/scenes/README.md).
+#include <algorithm>
 #include <filesystem>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
 #include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
 #include "read_file.hpp"
 
@@ -11,6 +14,51 @@ namespace cellrt {
 namespace {
 
 using nlohmann::json;
+
+// Where a text stops being JSON, found by reading it again event by event: of nlohmann's exceptions
+// only the syntax errors carry a position, not a number beyond a double's range (out_of_range 406).
+class ErrorPosition final : public json::json_sax_t {
+public:
+    // The byte offset of the first error in `text`, or its end when there is none.
+    static std::size_t in(const std::string& text) {
+        ErrorPosition sax;
+        sax.position_ = text.size();
+        json::sax_parse(text, &sax, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true);
+        return std::min(sax.position_, text.size());
+    }
+
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override { return true; }
+    bool key(string_t&) override { return true; }
+    bool end_object() override { return true; }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    bool parse_error(std::size_t position, const std::string&, const json::exception&) override {
+        position_ = position;
+        return false;
+    }
+
+private:
+    std::size_t position_ = 0;
+};
+
+// nlohmann's description of an error without its exception id ("[json.exception.parse_error.101] ")
+// and the position it gives in its own words ("parse error at line 1, column 31: "), since the
+// message names the line in cellrt's form.
+std::string reason(const json::exception& e) {
+    std::string_view what = e.what();
+    if (const std::size_t id = what.find("] "); what.starts_with("[json.exception.") && id != what.npos)
+        what.remove_prefix(id + 2);
+    if (const std::size_t at = what.find(": "); what.starts_with("parse error at line") && at != what.npos)
+        what.remove_prefix(at + 2);
+    return std::string(what);
+}
 
 class ViewReader {
 public:
@@ -44,8 +92,8 @@ public:
     int positive_int(const json& parent, const std::string& parent_name, const char* key) const {
         const std::string name = parent_name + "." + key;
         const json& j = field(parent, parent_name, key);
-        if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > 65536)
-            fail(name, "must be an integer in [1, 65536]");
+        if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > kMaxImageSide)
+            fail(name, "must be an integer in [1, " + std::to_string(kMaxImageSide) + "]");
         return static_cast<int>(j.get<long long>());
     }
 
@@ -54,8 +102,10 @@ public:
         json doc;
         try {
             doc = json::parse(text, nullptr, true, /*ignore_comments=*/true);
-        } catch (const json::parse_error& e) {
-            throw Error(path_ + ": invalid JSON: " + e.what());
+        } catch (const json::exception& e) {
+            const std::size_t at = ErrorPosition::in(text);
+            const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+            throw Error(path_ + ":" + std::to_string(line) + ": invalid JSON: " + reason(e));
         }
         if (!doc.is_object()) throw Error(path_ + ": a view file must be a JSON object");
 
@@ -63,7 +113,8 @@ public:
         if (!mesh.is_string() || mesh.get<std::string>().empty()) fail("mesh", "must be a non-empty string");
         const std::filesystem::path mesh_path =
             std::filesystem::path(path_).parent_path() / mesh.get<std::string>();
-        if (!std::filesystem::exists(mesh_path)) fail("mesh", "names " + mesh_path.string() + ", which does not exist");
+        if (!detail::file_exists(mesh_path.string()))
+            fail("mesh", "names " + mesh_path.string() + ", which does not exist");
 
         Scene scene;
         scene.name = doc.contains("name") && doc["name"].is_string()

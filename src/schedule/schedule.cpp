@@ -127,17 +127,24 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
             if (!steal(w)) return false;
         return true;
     };
+    // A worker whose packet throws stops the others at their next packet; the team rethrows.
+    std::atomic<bool> failed{false};
     auto work = [&](unsigned w) {
         WorkerLoad& load = loads[w].load;
         load.started_seconds = frame.seconds();
         CacheLineVector<Vec3>& colours = buffers[w];
-        for (std::size_t p; !cancelled(options) && next(w, p);) {
+        for (std::size_t p; !cancelled(options) && !failed.load(std::memory_order_relaxed) && next(w, p);) {
             const PixelRect r = grid.rect(p);
             const std::span<Vec3> out(colours.data(), static_cast<std::size_t>(r.pixels()));
-            timed(load, [&] {
-                trace(w, r, out);
-                store(image, r, out);
-            });
+            try {
+                timed(load, [&] {
+                    trace(w, r, out);
+                    store(image, r, out);
+                });
+            } catch (...) {
+                failed.store(true, std::memory_order_relaxed);
+                throw;
+            }
             if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, count);
         }
         load.finished_seconds = frame.seconds();
@@ -153,7 +160,7 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
 // that an oversubscribed machine still makes progress) models the hardware channel, which costs
 // hundreds of cycles, not an operating-system wake-up.
 struct Mailbox {
-    enum State : int { idle, work, done, stop };
+    enum State : int { idle, work, done, failed, stop };  // failed: the packet threw, the worker is gone
     alignas(kCacheLine) std::atomic<int> state{idle};
     PixelRect rect{};
     CacheLineVector<Vec3> colours;
@@ -179,23 +186,36 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
             int s;
             poll([&] { return (s = box.state.load(std::memory_order_acquire)) == Mailbox::work || s == Mailbox::stop; });
             if (s == Mailbox::stop) break;
-            timed(load, [&] {
-                trace(w, box.rect, std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
-            });
+            try {
+                timed(load, [&] {
+                    trace(w, box.rect,
+                          std::span<Vec3>(box.colours.data(), static_cast<std::size_t>(box.rect.pixels())));
+                });
+            } catch (...) {
+                box.state.store(Mailbox::failed, std::memory_order_release);
+                throw;  // the team rethrows it once the master has stopped the others
+            }
             box.state.store(Mailbox::done, std::memory_order_release);
         }
         load.finished_seconds = frame.seconds();
     };
     // The master (the study's PPU), on the calling thread: keeps the packet counter, posts each packet
     // to an idle worker, and writes every finished packet's colours into the frame buffer.
+    // After a worker's packet threw, no packet is posted; the ones in flight are awaited.
     std::size_t next = 0, done = 0, in_flight = 0;
+    bool failed = false;
     auto master = [&] {
         for (;;) {
-            const bool more = next < grid.count() && !cancelled(options);
+            const bool more = next < grid.count() && !cancelled(options) && !failed;
             if (in_flight == 0 && !more) break;
             bool progressed = false;
             for (Mailbox& b : boxes) {
                 const int s = b.state.load(std::memory_order_acquire);
+                if (s == Mailbox::failed) {
+                    b.state.store(Mailbox::stop, std::memory_order_relaxed);  // never posted to again
+                    --in_flight;
+                    failed = progressed = true;
+                }
                 if (s == Mailbox::done) {
                     store(image, b.rect, std::span<const Vec3>(b.colours.data(), static_cast<std::size_t>(b.rect.pixels())));
                     b.state.store(Mailbox::idle, std::memory_order_relaxed);
@@ -204,7 +224,8 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
                     progressed = true;
                     if (options.progress) options.progress(done, grid.count());
                 }
-                if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() && !cancelled(options)) {
+                if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() &&
+                    !cancelled(options) && !failed) {
                     b.rect = grid.rect(next++);
                     b.state.store(Mailbox::work, std::memory_order_release);
                     ++in_flight;
@@ -265,7 +286,10 @@ void packet_order(const PixelRect& rect, std::span<std::uint32_t> order) {
 }
 
 unsigned worker_count(const ScheduleOptions& options) {
-    return options.workers ? options.workers : std::max(1u, std::thread::hardware_concurrency());
+    if (options.workers > kMaxWorkers)
+        throw Error(std::to_string(options.workers) + " workers are more than the " + std::to_string(kMaxWorkers) +
+                    " a frame may have");
+    return options.workers ? options.workers : std::clamp(std::thread::hardware_concurrency(), 1u, kMaxWorkers);
 }
 
 bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,

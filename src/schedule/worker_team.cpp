@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <exception>
+#include <string>
+#include <system_error>
 #include <thread>
+#include <utility>
 
 #ifdef __linux__
 #include <pthread.h>
 #include <sched.h>
 #endif
+
+#include "cellrt/error.hpp"
 
 namespace cellrt::detail {
 namespace {
@@ -53,7 +58,12 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
         auto signal = std::make_unique<Signal>();
         threads_.reserve(threads_.size() + 1);
         signals_.reserve(signals_.size() + 1);
-        threads_.emplace_back([this, t, &s = *signal] { loop(t, s); });
+        try {
+            threads_.emplace_back([this, t, &s = *signal] { loop(t, s); });
+        } catch (const std::system_error& e) {
+            throw Error("cannot start a worker thread (" + std::to_string(t) + " running, " + std::to_string(n - 1) +
+                        " needed): " + e.code().message());
+        }
         signals_.push_back(std::move(signal));
     }
     set_affinity(pin);
@@ -77,19 +87,29 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
         signals_[t]->generation.fetch_add(1, std::memory_order_release);
         signals_[t]->generation.notify_one();
     }
-    std::exception_ptr failure;
-    try {
-        if (n > 0) job(0);
-    } catch (...) {
-        failure = std::current_exception();
-    }
+    if (n > 0) run_job(0);
     for (unsigned left = remaining_.load(std::memory_order_acquire); left != 0;)
         left = wait_for_change(remaining_, left, spin);
     job_ = nullptr;
 #ifdef __linux__
     if (pin) pthread_setaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
 #endif
+    std::exception_ptr failure;
+    {
+        std::lock_guard failure_lock(failure_mutex_);
+        failure = std::exchange(failure_, nullptr);
+    }
     if (failure) std::rethrow_exception(failure);
+}
+
+// An exception must not leave a team thread (that would be std::terminate): it becomes the run's.
+void WorkerTeam::run_job(unsigned j) {
+    try {
+        (*job_)(j);
+    } catch (...) {
+        std::lock_guard lock(failure_mutex_);
+        if (!failure_) failure_ = std::current_exception();
+    }
 }
 
 void WorkerTeam::loop(unsigned t, Signal& signal) {
@@ -98,7 +118,7 @@ void WorkerTeam::loop(unsigned t, Signal& signal) {
     for (std::chrono::microseconds spin{0};;) {
         seen = wait_for_change(signal.generation, seen, spin);
         if (stopping_) return;
-        (*job_)(t + 1);
+        run_job(t + 1);
         spin = std::chrono::microseconds(spin_microseconds_.load(std::memory_order_relaxed));
         if (remaining_.fetch_sub(1, std::memory_order_acq_rel) == 1) remaining_.notify_one();
     }

@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -42,7 +43,9 @@ public:
     // job j runs on core j (the caller's own affinity is restored afterwards); otherwise anywhere.
     // After the run the threads that took part poll for their next one for `spin` before they sleep
     // (0: sleep at once). One run at a time: a second caller waits for the first; a job must not call
-    // run() itself. An exception from job 0 is rethrown once the other jobs have returned.
+    // run() itself. An exception from any job is rethrown once every job has returned (the first one
+    // thrown, when several are), so a job that cannot go on must let the others know it stopped.
+    // Throws cellrt::Error when the system refuses to start a thread; the team stays as it was.
     void run(unsigned n, bool pin, std::chrono::microseconds spin, const std::function<void(unsigned)>& job);
 
 private:
@@ -53,6 +56,8 @@ private:
 
     void loop(unsigned t, Signal& signal);
     void set_affinity(bool pin);
+    // Runs job(j), keeping the first exception of the run in failure_.
+    void run_job(unsigned j);
 
     std::mutex run_mutex_;
     std::vector<std::thread> threads_;
@@ -63,6 +68,8 @@ private:
     bool stopping_ = false;
     std::atomic<std::int64_t> spin_microseconds_{0};
     std::atomic<unsigned> remaining_{0};  // threads that have not yet finished the current run
+    std::mutex failure_mutex_;
+    std::exception_ptr failure_;  // the current run's first exception
 };
 
 // The process's team, shared by every render.

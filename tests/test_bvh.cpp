@@ -1,0 +1,207 @@
+// The wide BVH beyond the checks every structure faces (test_structures.cpp): build variants stay
+// exact, the tree's invariants (every triangle in exactly one leaf, every box the exact bounds of
+// what lies below it, leaves no larger than asked), the same tree from the same input, rays along
+// its own box faces, and an empty scene.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <functional>
+#include <vector>
+
+#include "accel/routed_accelerator.hpp"
+#include "bvh/bvh_build.hpp"
+#include "cellrt/workload.hpp"
+#include "cellrt/error.hpp"
+#include "ray_suite.hpp"
+#include "scenes.hpp"
+
+namespace cellrt {
+namespace {
+
+using detail::BvhBuildOptions;
+using detail::BvhNode;
+using detail::BvhTree;
+
+AccelConfig bvh(std::map<std::string, std::string> params = {}) {
+    AccelConfig c{"bvh"};
+    c.params = std::move(params);
+    return c;
+}
+
+TEST(Bvh, BuildVariantsMatchBruteForce) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
+    for (const std::map<std::string, std::string>& params : std::vector<std::map<std::string, std::string>>{
+             {{"max_leaf", "1"}}, {{"max_leaf", "3"}}, {{"bins", "2"}}, {{"bins", "256"}},
+             {{"traversal_cost", "1000"}}, {{"intersection_cost", "1000"}}}) {
+        std::string what = "bvh";
+        for (const auto& [k, v] : params) what += " " + k + "=" + v;
+        test::expect_matches(*make_accelerator(scene.triangles, bvh(params)), ref, what);
+    }
+}
+
+// Walks the wide tree: every leaf's lanes name triangles (each exactly once over the tree) whose
+// vertices the lanes hold, and every child box is exactly the bounds of the triangles below it.
+void check_tree(const BvhTree& tree, std::span<const Triangle> tris, int max_leaf) {
+    std::vector<int> seen(tris.size(), 0);
+    std::function<Box3(std::uint32_t)> walk = [&](std::uint32_t word) -> Box3 {
+        Box3 bounds;
+        if (BvhNode::is_leaf(word)) {
+            const detail::BvhLeaf& leaf = tree.leaves[BvhNode::leaf_index(word)];
+            const std::uint32_t n = BvhNode::leaf_count(word);
+            EXPECT_LE(n, static_cast<std::uint32_t>(max_leaf));
+            for (std::uint32_t lane = 0; lane < detail::kBvhWidth; ++lane) {
+                if (lane >= n) {
+                    EXPECT_EQ(leaf.prim[lane], kNoHit);
+                    continue;
+                }
+                const std::uint32_t p = leaf.prim[lane];
+                EXPECT_LT(p, tris.size());
+                if (p >= tris.size()) continue;
+                ++seen[p];
+                const Vec3* v[3] = {&tris[p].v0, &tris[p].v1, &tris[p].v2};
+                for (int k = 0; k < 3; ++k)
+                    for (int a = 0; a < 3; ++a) EXPECT_EQ(leaf.v[k][a][lane], (*v[k])[static_cast<std::size_t>(a)]);
+                bounds.extend(tris[p].bounds());
+            }
+            return bounds;
+        }
+        const BvhNode& node = tree.nodes[word];
+        for (int k = 0; k < detail::kBvhWidth; ++k) {
+            if (node.child[k] == BvhNode::kEmptyChild) {
+                EXPECT_GT(node.lo[0][k], node.hi[0][k]) << "an empty slot's box is empty";
+                continue;
+            }
+            const Box3 child = walk(node.child[k]);
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_EQ(node.lo[a][k], child.lo[a]);
+                EXPECT_EQ(node.hi[a][k], child.hi[a]);
+            }
+            bounds.extend(child);
+        }
+        return bounds;
+    };
+    const Box3 root = walk(0);
+    EXPECT_EQ(root, tree.bounds);
+    for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i;
+}
+
+TEST(Bvh, EveryTriangleInOneLeafAndEveryBoxExact) {
+    for (const char* name : {"builtin:spheres?tris=3000", "builtin:city?tris=5000", "builtin:forest?tris=5000"}) {
+        const Scene& scene = test::cached_scene(name);
+        for (int max_leaf : {1, 5, 8}) {
+            BvhBuildOptions o;
+            o.max_leaf = max_leaf;
+            SCOPED_TRACE(std::string(name) + " max_leaf " + std::to_string(max_leaf));
+            check_tree(detail::build_bvh(scene.triangles, o), scene.triangles, max_leaf);
+        }
+    }
+}
+
+// Triangles that all share one centroid leave the SAH nothing to split: the object median takes
+// over, and the tree stays valid and shallow.
+TEST(Bvh, CoincidentCentroidsSplitAtTheMedian) {
+    std::vector<Triangle> tris;
+    for (int i = 0; i < 5000; ++i) {
+        const float s = 1.f + static_cast<float>(i % 50);
+        tris.push_back({{-s, 0.f, 0.f}, {s, 0.f, 0.f}, {0.f, 0.f, 0.f}});
+    }
+    const BvhTree tree = detail::build_bvh(tris, BvhBuildOptions{});
+    check_tree(tree, tris, 8);
+    EXPECT_LT(tree.depth, 20);
+}
+
+TEST(Bvh, SameInputSameTree) {
+    const Scene& scene = test::cached_scene("builtin:city?tris=5000");
+    const BvhTree a = detail::build_bvh(scene.triangles, BvhBuildOptions{});
+    const BvhTree b = detail::build_bvh(scene.triangles, BvhBuildOptions{});
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    ASSERT_EQ(a.leaves.size(), b.leaves.size());
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)), 0);
+    EXPECT_EQ(std::memcmp(a.leaves.data(), b.leaves.data(), a.leaves.size() * sizeof(detail::BvhLeaf)), 0);
+}
+
+// Rays that run exactly along the faces of the tree's own boxes (where the slab test's distances are
+// 0 x infinity) and start on them.
+TEST(Bvh, RaysAlongItsOwnBoxFaces) {
+    const Scene& scene = test::cached_scene("builtin:city?tris=5000");
+    const BvhTree tree = detail::build_bvh(scene.triangles, BvhBuildOptions{});
+    std::vector<Ray> rays;
+    const Vec3 c = tree.bounds.center();
+    for (std::size_t n = 0; n < tree.nodes.size() && rays.size() < 6000; n += 3) {
+        const BvhNode& node = tree.nodes[n];
+        for (int k = 0; k < detail::kBvhWidth; ++k) {
+            if (node.child[k] == BvhNode::kEmptyChild) continue;
+            for (int a = 0; a < 3; ++a) {
+                Ray r;
+                r.org = c;
+                r.org[static_cast<std::size_t>(a)] = node.lo[a][k];
+                r.dir = Vec3{1.f, 1.f, 1.f};
+                r.dir[static_cast<std::size_t>(a)] = 0.f;  // within the face's plane
+                rays.push_back(r);
+                r.dir = Vec3{0.f, 0.f, 0.f};
+                r.dir[static_cast<std::size_t>(a)] = 1.f;  // from the face, along the axis
+                r.org[static_cast<std::size_t>((a + 1) % 3)] = node.hi[(a + 1) % 3][k];
+                rays.push_back(r);
+            }
+        }
+    }
+    const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
+    test::expect_matches(*make_accelerator(scene.triangles, bvh()), ref, "bvh on its box faces");
+}
+
+TEST(Bvh, EmptySceneMissesEverything) {
+    const auto accel = make_accelerator({}, bvh());
+    std::vector<Ray> rays(5);
+    for (Ray& r : rays) r.dir = {0.f, 0.f, 1.f};
+    std::vector<Hit> hits(rays.size(), Hit{1.f, 7, 0.f, 0.f});
+    std::vector<std::uint8_t> occluded(rays.size(), 1);
+    TraversalCounters counters;
+    accel->intersect(rays, hits, &counters);
+    accel->occluded(rays, occluded);
+    for (const Hit& h : hits) EXPECT_FALSE(h.is_hit());
+    for (std::uint8_t o : occluded) EXPECT_EQ(o, 0);
+    EXPECT_EQ(counters.rays, rays.size());
+    EXPECT_EQ(accel->stats().memory_bytes, 0u);
+}
+
+TEST(Bvh, RefusesBadParameters) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
+    for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+             {"max_leaf", "0"}, {"max_leaf", "9"}, {"bins", "1"}, {"bins", "257"}, {"traversal_cost", "0"},
+             {"intersection_cost", "-1"}, {"leaf_size", "4"}})
+        EXPECT_THROW(make_accelerator(scene.triangles, bvh({{k, v}})), Error) << k << "=" << v;
+    AccelConfig c = bvh();
+    c.traversal = "branched";
+    EXPECT_THROW(make_accelerator(scene.triangles, c), Error);
+}
+
+// The router's measure: a frame's primary rays and the shadow rays of their hits are coherent, its
+// diffuse bounces and random directions are not, and invalid rays do not count.
+TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
+    const Scene& scene = test::cached_scene("builtin:city?tris=5000");
+    const auto kd = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    ShadingOptions diffuse;
+    diffuse.shading = Shading::diffuse;
+    const FrameRays frame = frame_rays(scene, 64, 64, 16, *kd);
+    const FrameRays bounces = frame_rays(scene, 64, 64, 16, *kd, diffuse);
+    for (const FrameRays::Packet& p : frame.packets) {
+        EXPECT_GT(detail::batch_coherence(std::span(frame.primary).subspan(p.primary, p.primary_count)), 0.9f);
+        if (p.secondary_count > 16) {
+            EXPECT_GT(detail::batch_coherence(std::span(frame.secondary).subspan(p.secondary, p.secondary_count)), 0.9f);
+        }
+    }
+    for (const FrameRays::Packet& p : bounces.packets) {
+        if (p.secondary_count > 16) {
+            EXPECT_LT(detail::batch_coherence(std::span(bounces.secondary).subspan(p.secondary, p.secondary_count)), 0.6f);
+        }
+    }
+    std::vector<Ray> invalid(8);
+    for (Ray& r : invalid) r.dir = {0.f, 0.f, 0.f};
+    invalid[3].dir = {1.f, 0.f, 0.f};
+    EXPECT_EQ(detail::batch_coherence(invalid), 1.f);
+    EXPECT_EQ(detail::batch_coherence({}), 1.f);
+}
+
+}  // namespace
+}  // namespace cellrt
