@@ -12,8 +12,12 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -22,15 +26,36 @@
 #include <random>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cellrt/accel.hpp"
 #include "cellrt/brute_force.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 namespace cellrt::test {
+
+// body(begin, end) over [0, n) in chunks, on every core at once: the many threads that call one
+// accelerator. std::threads rather than TBB's, so that ThreadSanitizer sees how they are ordered
+// (Debian's libtbb is not instrumented; docs/RELIABILITY.md). The first exception is rethrown here.
+template <class Body>
+void parallel_chunks(std::size_t n, std::size_t chunk, Body body) {
+    std::atomic<std::size_t> next{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto work = [&] {
+        try {
+            for (std::size_t b; (b = next.fetch_add(chunk)) < n;) body(b, std::min(n, b + chunk));
+        } catch (...) {
+            std::lock_guard lock(error_mutex);
+            if (!error) error = std::current_exception();
+        }
+    };
+    std::vector<std::thread> threads;
+    for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) threads.emplace_back(work);
+    work();
+    for (std::thread& t : threads) t.join();
+    if (error) std::rethrow_exception(error);
+}
 
 struct RaySuiteOptions {
     std::size_t random = 20000;       // origins in the enlarged scene box, directions uniform
@@ -187,10 +212,9 @@ inline ReferenceAnswers compute_reference(std::span<const Triangle> tris, std::v
     ref.hits.resize(ref.rays.size());
     ref.occluded.resize(ref.rays.size());
     const std::span<const Ray> all(ref.rays);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.size(), 256), [&](const auto& r) {
-        const auto n = r.end() - r.begin();
-        brute->intersect(all.subspan(r.begin(), n), std::span(ref.hits).subspan(r.begin(), n));
-        brute->occluded(all.subspan(r.begin(), n), std::span(ref.occluded).subspan(r.begin(), n));
+    parallel_chunks(all.size(), 256, [&](std::size_t b, std::size_t e) {
+        brute->intersect(all.subspan(b, e - b), std::span(ref.hits).subspan(b, e - b));
+        brute->occluded(all.subspan(b, e - b), std::span(ref.occluded).subspan(b, e - b));
     });
     return ref;
 }
@@ -259,40 +283,63 @@ inline bool sample_agrees(std::span<const Triangle> tris, const ReferenceAnswers
 
 }  // namespace detail
 
-// reference_suite() of a triangle set, computed once and shared by every structure and traversal
-// tested on it: in memory within a process, on disk across processes (CELLRT_TEST_CACHE).
-inline const ReferenceAnswers& cached_reference(const std::string& key, std::span<const Triangle> tris) {
-    static std::mutex mutex;
-    static std::map<std::string, std::unique_ptr<ReferenceAnswers>> cache;
-    std::lock_guard lock(mutex);
-    auto& slot = cache[key];
-    if (slot) return *slot;
-    const std::vector<Ray> rays = RaySuite(tris, RaySuiteOptions{}).rays();
-    const std::uint64_t h = detail::fnv1a(rays.data(), rays.size() * sizeof(Ray),
-                                          detail::fnv1a(tris.data(), tris.size_bytes()));
-    std::filesystem::create_directories(CELLRT_TEST_CACHE);
+// The folder of the cached answers: this build tree's, or the one CELLRT_TEST_CACHE names, which
+// tools/test.sh points at the Release build's for the sanitizer runs: brute force over a shared scene
+// is minutes under AddressSanitizer, and a sample of every file is still recomputed there.
+inline std::string reference_cache_dir() {
+    if (const char* env = std::getenv("CELLRT_TEST_CACHE")) return env;
+    return CELLRT_TEST_CACHE;
+}
+
+// The answers `compute` gives, kept on disk under a key made of the triangles and `rays` (the rays
+// the answers start from): one process computes, those that need the same answers wait for its file.
+template <class Compute>
+ReferenceAnswers stored_answers(std::span<const Triangle> tris, std::span<const Ray> rays, Compute compute) {
+    const std::uint64_t h = detail::fnv1a(rays.data(), rays.size_bytes(), detail::fnv1a(tris.data(), tris.size_bytes()));
+    const std::string dir = reference_cache_dir();
+    std::filesystem::create_directories(dir);
     char name[32];
     std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(h));
-    const std::string path = std::string(CELLRT_TEST_CACHE) + "/" + name + ".ref";
-    // One process computes, the others wait for its file.
+    const std::string path = dir + "/" + name + ".ref";
     const int lock_fd = ::open((path + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
     if (lock_fd >= 0) ::flock(lock_fd, LOCK_EX);
-    auto ref = std::make_unique<ReferenceAnswers>();
+    ReferenceAnswers ref;
     std::size_t expected = 0;
     {
         std::ifstream in(path, std::ios::binary);
         std::uint64_t n = 0;
         if (in.read(reinterpret_cast<char*>(&n), sizeof n)) expected = n;
     }
-    if (expected == 0 || !detail::read_reference(path, expected, *ref) || !detail::sample_agrees(tris, *ref)) {
-        *ref = reference_suite(tris);
-        detail::write_reference(path, *ref);
+    if (expected == 0 || !detail::read_reference(path, expected, ref) || !detail::sample_agrees(tris, ref)) {
+        ref = compute();
+        detail::write_reference(path, ref);
     }
     if (lock_fd >= 0) {
         ::flock(lock_fd, LOCK_UN);
         ::close(lock_fd);
     }
-    slot = std::move(ref);
+    return ref;
+}
+
+// compute_reference() of `rays`, kept on disk: the tests of every structure on one scene's frame share it.
+inline ReferenceAnswers stored_reference(std::span<const Triangle> tris, const std::vector<Ray>& rays) {
+    return stored_answers(tris, rays, [&] { return compute_reference(tris, rays); });
+}
+
+// reference_suite() of `tris`, kept on disk: the tests of every structure on the same triangles share it.
+inline ReferenceAnswers stored_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {}) {
+    const std::vector<Ray> rays = RaySuite(tris, options).rays();
+    return stored_answers(tris, rays, [&] { return reference_suite(tris, options); });
+}
+
+// reference_suite() of a triangle set, computed once and shared by every structure and traversal
+// tested on it: in memory within a process, on disk across processes.
+inline const ReferenceAnswers& cached_reference(const std::string& key, std::span<const Triangle> tris) {
+    static std::mutex mutex;
+    static std::map<std::string, std::unique_ptr<ReferenceAnswers>> cache;
+    std::lock_guard lock(mutex);
+    auto& slot = cache[key];
+    if (!slot) slot = std::make_unique<ReferenceAnswers>(stored_suite(tris));
     return *slot;
 }
 
@@ -302,10 +349,9 @@ inline std::size_t expect_matches(const Accelerator& tested, const ReferenceAnsw
     std::vector<Hit> got(ref.rays.size());
     std::vector<std::uint8_t> got_occ(ref.rays.size());
     const std::span<const Ray> all(ref.rays);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, all.size(), 256), [&](const auto& r) {
-        const auto n = r.end() - r.begin();
-        tested.intersect(all.subspan(r.begin(), n), std::span(got).subspan(r.begin(), n));
-        tested.occluded(all.subspan(r.begin(), n), std::span(got_occ).subspan(r.begin(), n));
+    parallel_chunks(all.size(), 256, [&](std::size_t b, std::size_t e) {
+        tested.intersect(all.subspan(b, e - b), std::span(got).subspan(b, e - b));
+        tested.occluded(all.subspan(b, e - b), std::span(got_occ).subspan(b, e - b));
     });
     std::size_t bad = 0;
     for (std::size_t i = 0; i < ref.rays.size(); ++i) {

@@ -55,7 +55,7 @@ Answers answer(const Accelerator& accel, const std::vector<Ray>& rays) {
     for (std::size_t s = 0, n = 1; s < rays.size(); s += n, n = n % 300 + 37) starts.push_back(s);
     starts.push_back(rays.size());
     const std::span<const Ray> all(rays);
-    tbb::parallel_for(std::size_t(0), starts.size() - 1, [&](std::size_t b) {
+    test::parallel_chunks(starts.size() - 1, 1, [&](std::size_t b, std::size_t) {
         const std::size_t s = starts[b], n = starts[b + 1] - starts[b];
         accel.intersect(all.subspan(s, n), std::span(a.hits).subspan(s, n));
         accel.occluded(all.subspan(s, n), std::span(a.occluded).subspan(s, n));

@@ -24,6 +24,7 @@
 #include "profile/frame_profile.hpp"
 #include "profile/hardware_counters.hpp"
 #include "profile/measured_accelerator.hpp"
+#include "sanitizers.hpp"
 
 namespace cellrt {
 namespace {
@@ -258,6 +259,7 @@ std::vector<std::string> branch_loops_command() {
 TEST(ProfileCallgrind, CountsAKnownLoopExactlyAndItsMispredictions) {
     if (!kHaveBranchLoop) GTEST_SKIP() << "the synthetic loop is x86-64 assembly";
     if (profile::find_valgrind().empty()) GTEST_SKIP() << "valgrind not found on PATH";
+    CELLRT_SKIP_UNDER_SANITIZERS("valgrind cannot run this sanitized test program");
     const double n = kLoopIterations;
     profile::CallgrindOptions random_opts, steady_opts;
     random_opts.toggle_collect = {"*random_branches*"};
@@ -419,6 +421,7 @@ TEST(ProfileCli, ReportsBothRegionsAndTheKernelsWork) {
     const bool hardware =
         profile::HardwareCounters::open(profile::HardwareCounters::Threads::calling_and_new, why).has_value();
     if (!hardware && profile::find_valgrind().empty()) GTEST_SKIP() << why << "; and valgrind not found on PATH";
+    if (!hardware) CELLRT_SKIP_UNDER_SANITIZERS(why << "; and valgrind cannot run the sanitized cellrt program");
     const std::string spec = "builtin:spheres?tris=300";
     const auto dir = std::filesystem::temp_directory_path() / ("cellrt_profile_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);

@@ -11,6 +11,7 @@
 
 #include "cellrt/scene.hpp"
 #include "cellrt/timer.hpp"
+#include "sanitizers.hpp"
 #include "scenes.hpp"
 
 namespace cellrt {
@@ -54,6 +55,7 @@ TEST(SharedScenes, ReadmeTableMatchesTheExpectedCounts) {
 // Release build is held to it.
 TEST(SharedScenes, SponzaLoadsWellUnderASecond) {
     CELLRT_REQUIRE_SHARED_SCENE(path, "sponza");
+    CELLRT_SKIP_UNDER_SANITIZERS("a time bound for uninstrumented code");
     const Timer timer;
     const Scene scene = load_scene(path);
     const double seconds = timer.seconds();

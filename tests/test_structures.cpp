@@ -64,7 +64,7 @@ class DegenerateInputs : public testing::TestWithParam<std::string> {};
 
 TEST_P(DegenerateInputs, SameHits) {
     for (const auto& [name, tris] : test::degenerate_scenes()) {
-        const test::ReferenceAnswers ref = test::reference_suite(tris, test::small_suite());
+        const test::ReferenceAnswers ref = test::stored_suite(tris, test::small_suite());
         test::expect_matches(*make_accelerator(tris, parse_accel_config(GetParam())), ref, GetParam() + " on " + name);
     }
 }
@@ -89,13 +89,13 @@ TEST_P(CoherentPackets, SameHits) {
             for (int tx = 0; tx < size; tx += tile)
                 for (int y = ty; y < ty + tile; ++y)
                     for (int x = tx; x < tx + tile; ++x) rays.push_back(camera.primary(x, y));
-    test::ReferenceAnswers ref = test::compute_reference(scene->triangles, rays);
+    test::ReferenceAnswers ref = test::stored_reference(scene->triangles, rays);
     for (std::size_t i = 0; i < ref.rays.size(); ++i)
         if (ref.hits[i].is_hit()) {
             const SurfacePoint sp = surface_point(scene->triangles[ref.hits[i].prim], ref.rays[i], ref.hits[i]);
             rays.push_back(shadow_ray(sp.position, sp.normal, scene->light.position));
         }
-    ref = test::compute_reference(scene->triangles, rays);
+    ref = test::stored_reference(scene->triangles, rays);
     const auto accel = make_accelerator(scene->triangles, parse_accel_config(config));
     for (std::size_t batch : {64u, 256u, 37u}) {
         std::vector<Hit> hits(rays.size());

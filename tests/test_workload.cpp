@@ -20,8 +20,9 @@
 namespace cellrt {
 namespace {
 
+// memcmp must not be given a null pointer even for 0 bytes, and an empty span's data() may be one.
 bool same_rays(std::span<const Ray> a, std::span<const Ray> b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size_bytes()) == 0);
 }
 
 // A size whose edge packets are cut on both sides, so partial packets are covered.

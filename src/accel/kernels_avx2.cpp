@@ -3,8 +3,12 @@
 #include "accel/isa_unit.hpp"
 
 #if defined(__x86_64__)
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace cellrt::detail::isa_avx2 {
 constexpr int kLanes = 8;
 #define CELLRT_SIMD_AVX2
@@ -18,7 +22,11 @@ constexpr int kLanes = kBvhWidth;
 }  // namespace wide
 #undef CELLRT_SIMD_AVX2
 }  // namespace cellrt::detail::isa_avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx2() { return isa_avx2::kernels(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() { return isa_avx2::wide::bvh_kernels("avx2"); }

@@ -3,8 +3,12 @@
 #include "accel/isa_unit.hpp"
 
 #if defined(__x86_64__)
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512vl,avx512dq,avx512bw"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512vl,avx512dq,avx512bw")
+#endif
 namespace cellrt::detail::isa_avx512 {
 constexpr int kLanes = 16;
 #define CELLRT_SIMD_AVX512
@@ -18,7 +22,11 @@ constexpr int kLanes = kBvhWidth;
 }  // namespace wide
 #undef CELLRT_SIMD_AVX512
 }  // namespace cellrt::detail::isa_avx512
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx512() { return isa_avx512::kernels(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return isa_avx512::wide::bvh_kernels("avx512"); }

@@ -8,8 +8,12 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 #if defined(__x86_64__)
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("sse4.2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("sse4.2")
+#endif
 namespace cellrt::detail::isa_sse {
 constexpr int kLanes = 4;
 #define CELLRT_SIMD_SSE
@@ -23,7 +27,11 @@ constexpr int kLanes = kBvhWidth;
 }  // namespace wide
 #undef CELLRT_SIMD_SSE
 }  // namespace cellrt::detail::isa_sse
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_sse() { return isa_sse::kernels(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() { return isa_sse::wide::bvh_kernels("sse"); }
