@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
         const auto accel = cellrt::make_accelerator(scene.triangles, cellrt::parse_accel_config(argv[2]));
         std::ifstream in(argv[3], std::ios::binary);
         const std::vector<char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-        if (!in.eof() || bytes.size() % sizeof(cellrt::Ray) != 0) throw cellrt::Error(std::string(argv[3]) + ": not Ray records");
+        if (!in || bytes.size() % sizeof(cellrt::Ray) != 0) throw cellrt::Error(std::string(argv[3]) + ": not Ray records");
         std::vector<cellrt::Ray> rays(bytes.size() / sizeof(cellrt::Ray));
         std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(rays.data()));
         std::ofstream out(argv[4], std::ios::binary);
