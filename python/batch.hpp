@@ -80,8 +80,9 @@ std::string invalid_ray_message(const RayInput& in, std::size_t index);
 
 // The C++ side of the benchmark: the batch assembled into Ray records once, then traced `repeats`
 // times with the same chunks and threads into a Hit array kept between them, as a C++ program would;
-// the seconds of each trace. Expects valid rays.
+// the seconds of each trace, wall-clock or (`cpu`) the process's CPU time, all threads together.
+// Expects valid rays.
 std::vector<double> native_intersect_seconds(const Accelerator& accel, const Team& team, const RayInput& in,
-                                             int repeats);
+                                             int repeats, bool cpu);
 
 }  // namespace cellrt::python

@@ -317,11 +317,13 @@ PYBIND11_MODULE(cellrt, m) {
     m.def("_reads_in_place", [](py::handle array) { return float_rows(array, "array", 3).borrowed; });
     m.def(
         "_native_intersect_seconds",
-        [](const PyAccelerator& a, py::handle origins, py::handle directions, int repeats) {
+        [](const PyAccelerator& a, py::handle origins, py::handle directions, int repeats, py::handle clock) {
+            const std::string which = text(clock, "clock");
+            if (which != "wall" && which != "cpu") throw py::value_error("clock must be 'wall' or 'cpu'");
             const RayInput in = ray_input(origins, directions, py::float_(0.0),
                                           py::float_(std::numeric_limits<double>::infinity()));
             py::gil_scoped_release unlocked;
-            return native_intersect_seconds(*a.accel, a.team, in, repeats);
+            return native_intersect_seconds(*a.accel, a.team, in, repeats, which == "cpu");
         },
-        py::arg("accelerator"), py::arg("origins"), py::arg("directions"), py::arg("repeats"));
+        py::arg("accelerator"), py::arg("origins"), py::arg("directions"), py::arg("repeats"), py::arg("clock") = "wall");
 }
