@@ -68,13 +68,13 @@ bool is_source(const fs::path& p) {
     return e == ".hpp" || e == ".cpp" || e == ".inl" || e == ".h" || e == ".cu" || e == ".cuh";
 }
 
-// Every violation of the rule in the tree at `root` (folders src, include, apps, bench, tests): a file
+// Every violation of the rule in the tree at `root` (folders src, include, apps, bench, tests, python): a file
 // no module holds, or an include that climbs a layer or crosses to a sibling module.
 std::vector<std::string> violations(const fs::path& root, const std::vector<Module>& modules) {
     std::vector<std::string> out;
     if (modules.empty()) return {"no table of layers found"};
     const std::regex include(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
-    for (const char* top : {"src", "include", "apps", "bench", "tests"}) {
+    for (const char* top : {"src", "include", "apps", "bench", "tests", "python"}) {
         if (!fs::exists(root / top)) continue;
         std::vector<fs::path> files;
         for (const auto& f : fs::recursive_directory_iterator(root / top))
@@ -167,7 +167,7 @@ TEST(Architecture, StructureTypesAndKindsStayInTheirFolders) {
     const std::regex names(R"(\b(KdNode|BihNode|KdTree|BihTree|KdTraits|BihTraits|KdStructure|BihStructure)\b)");
     const std::regex kinds(R"re([!=]=\s*"(kd|bih)"|"(kd|bih)"\s*[!=]=)re");
     std::vector<std::string> found;
-    for (const char* top : {"src", "include", "apps", "bench"})
+    for (const char* top : {"src", "include", "apps", "bench", "python"})
         for (const auto& f : fs::recursive_directory_iterator(kRoot / top)) {
             if (!f.is_regular_file() || !is_source(f.path())) continue;
             const std::string rel = fs::relative(f.path(), kRoot).generic_string();

@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Rays per second from Python against the same C++ call without Python, in one run.
+
+    PYTHONPATH=build/python python3 bench/python_bench.py [SCENE] [--kinds kd,bvh] [--repeats 9] [--clock cpu]
+
+For each kind, `acc.intersect(origins, directions)` on a batch of 1024 x 1024 rays (the camera's
+primary rays, and the same number of incoherent rays: random origins in the scene's box toward random
+triangles) is timed from Python (arguments checked, rays assembled from the numpy arrays, four result
+arrays allocated and filled), interleaved with `cellrt._native_intersect_seconds`: the very chunks and
+threads traced from Ray records built beforehand into a Hit array kept between calls, as a C++ program
+would. Medians of --repeats runs of each; the ratio is Python's rays/s over C++'s (docs/PYTHON.md)."""
+import argparse
+import os
+import statistics
+import time
+
+import numpy as np
+
+import cellrt
+
+
+def incoherent_rays(scene, count, seed=1):
+    rng = np.random.default_rng(seed)
+    tris = scene.triangles
+    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
+    origins = rng.uniform(lo, hi, size=(count, 3)).astype(np.float32)
+    targets = tris[rng.integers(0, len(tris), size=count)].mean(1)
+    return origins, (targets - origins).astype(np.float32)
+
+
+def main():
+    default_scene = "../shared/scenes/sponza/sponza.json"
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="?", default=default_scene if os.path.exists(default_scene) else "builtin:city")
+    parser.add_argument("--kinds", default="kd,bvh")
+    parser.add_argument("--repeats", type=int, default=9)
+    parser.add_argument("--threads", type=int, default=0)
+    parser.add_argument("--side", type=int, default=1024, help="batch of SIDE x SIDE rays")
+    parser.add_argument("--clock", choices=["wall", "cpu"], default="wall",
+                        help="cpu: the process's CPU time, all threads (steadier on a shared machine)")
+    args = parser.parse_args()
+    clock = time.process_time if args.clock == "cpu" else time.perf_counter
+    scene = cellrt.load_scene(args.scene)
+    batches = {"camera": scene.camera.rays(args.side, args.side),
+               "incoherent": incoherent_rays(scene, args.side * args.side)}
+    print(f"{scene.name}: {len(scene.triangles)} triangles, batches of {args.side * args.side} rays, "
+          f"threads {args.threads or os.cpu_count()}, median of {args.repeats}, {args.clock} clock")
+    print(f"{'kind':6} {'rays':11} {'Python Mrays/s':>15} {'C++ Mrays/s':>12} {'ratio':>7}")
+    for kind in args.kinds.split(","):
+        acc = cellrt.Accelerator(scene.triangles, kind=kind, threads=args.threads)
+        for name, (o, d) in batches.items():
+            n = len(o)
+            acc.intersect(o, d)  # warm: pages of the result arrays, the team's threads
+            py, cpp = [], []
+            for _ in range(args.repeats):
+                start = clock()
+                acc.intersect(o, d)
+                py.append(clock() - start)
+                cpp.extend(cellrt._native_intersect_seconds(acc, o, d, 1, args.clock))
+            p, c = n / statistics.median(py) * 1e-6, n / statistics.median(cpp) * 1e-6
+            print(f"{kind:6} {name:11} {p:15.2f} {c:12.2f} {p / c:7.3f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,184 @@
+#include "arrays.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "cellrt/ray.hpp"
+
+namespace cellrt::python {
+namespace {
+
+py::module_ numpy() { return py::module_::import("numpy"); }
+
+// What numpy said, without the exception type's name.
+std::string message_of(const py::error_already_set& e) { return py::str(e.value()).cast<std::string>(); }
+
+py::array as_array(py::handle object, const std::string& name) {
+    if (py::isinstance<py::array>(object)) return py::reinterpret_borrow<py::array>(object);
+    try {
+        return numpy().attr("asarray")(object);
+    } catch (py::error_already_set& e) {
+        throw py::value_error(name + " is not an array: " + message_of(e));
+    }
+}
+
+std::string dtype_of(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+void check_real(const py::array& a, const std::string& name) {
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+        throw py::value_error(name + " must hold real numbers, got dtype " + dtype_of(a));
+}
+
+// `a` as a C-contiguous, aligned array of `dtype`: `a` itself where it is one already.
+py::array required(const py::array& a, const char* dtype, const std::string& name) {
+    try {
+        return numpy().attr("require")(a, dtype, "CA");
+    } catch (py::error_already_set& e) {
+        throw py::value_error(name + " cannot be converted to " + dtype + ": " + message_of(e));
+    }
+}
+
+FloatRows rows_of(const py::array& a, const std::string& name, std::size_t rows) {
+    FloatRows r;
+    r.array = required(a, "float32", name);
+    r.data = static_cast<const float*>(r.array.data());
+    r.rows = rows;
+    r.borrowed = r.array.data() == a.data();
+    return r;
+}
+
+std::string vec_text(const float* p) {
+    return "(" + py::repr(py::float_(p[0])).cast<std::string>() + ", " + py::repr(py::float_(p[1])).cast<std::string>() +
+           ", " + py::repr(py::float_(p[2])).cast<std::string>() + ")";
+}
+
+bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+// Hits name triangles by a uint32 index, kNoHit reserved for a miss.
+void check_triangle_count(std::size_t count, const std::string& name) {
+    if (count >= kNoHit)
+        throw py::value_error(name + " has " + std::to_string(count) + " triangles; at most " +
+                              std::to_string(kNoHit - 1) + " are indexable");
+}
+
+}  // namespace
+
+std::string shape_of(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+FloatRows float_rows(py::handle object, const std::string& name, std::size_t columns) {
+    const py::array a = as_array(object, name);
+    if (a.ndim() != 2 || a.shape(1) != static_cast<py::ssize_t>(columns))
+        throw py::value_error(name + " must have shape (N, " + std::to_string(columns) + "), got " + shape_of(a));
+    check_real(a, name);
+    return rows_of(a, name, static_cast<std::size_t>(a.shape(0)));
+}
+
+FloatRows triangle_rows(py::handle object, const std::string& name) {
+    const py::array a = as_array(object, name);
+    if (a.ndim() != 3 || a.shape(1) != 3 || a.shape(2) != 3)
+        throw py::value_error(name + " must have shape (M, 3, 3), got " + shape_of(a) +
+                              " (vertices of shape (N, 3) need faces)");
+    check_real(a, name);
+    return rows_of(a, name, static_cast<std::size_t>(a.shape(0)));
+}
+
+Bound ray_bound(py::handle object, const std::string& name, std::size_t rays) {
+    const py::array a = as_array(object, name);
+    check_real(a, name);
+    Bound b;
+    if (a.ndim() == 0) {
+        b.scalar = *static_cast<const float*>(required(a, "float32", name).data());
+        if (std::isnan(b.scalar)) throw py::value_error(name + " is NaN");
+        return b;
+    }
+    if (a.ndim() != 1)
+        throw py::value_error(name + " must be a scalar or have shape (N,), got " + shape_of(a));
+    if (static_cast<std::size_t>(a.shape(0)) != rays)
+        throw py::value_error(name + " has " + std::to_string(a.shape(0)) + " values for " + std::to_string(rays) +
+                              " rays");
+    b.values = rows_of(a, name, rays);
+    return b;
+}
+
+std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
+    const FloatRows v = float_rows(vertices, "vertices", 3);
+    for (std::size_t i = 0; i < v.rows; ++i)
+        if (!finite3(v.data + 3 * i))
+            throw py::value_error("vertices[" + std::to_string(i) + "] = " + vec_text(v.data + 3 * i) +
+                                  " is not finite");
+    const py::array f = as_array(faces, "faces");
+    if (f.ndim() != 2 || f.shape(1) != 3)
+        throw py::value_error("faces must have shape (M, 3), got " + shape_of(f));
+    const char kind = f.dtype().kind();
+    if (kind != 'i' && kind != 'u') throw py::value_error("faces must hold integers, got dtype " + dtype_of(f));
+    const std::size_t m = static_cast<std::size_t>(f.shape(0));
+    check_triangle_count(m, "faces");
+    // uint64 indices beyond int64 wrap to negative values, which the range check refuses.
+    const py::array idx = required(f, "int64", "faces");
+    const auto* index = static_cast<const std::int64_t*>(idx.data());
+    std::vector<Triangle> tris(m);
+    for (std::size_t t = 0; t < m; ++t) {
+        Vec3* corner = &tris[t].v0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const std::int64_t k = index[3 * t + c];
+            if (k < 0 || static_cast<std::uint64_t>(k) >= v.rows)
+                throw py::value_error("faces[" + std::to_string(t) + ", " + std::to_string(c) + "] = " +
+                                      std::to_string(k) + " is out of range for " + std::to_string(v.rows) +
+                                      " vertices");
+            const float* p = v.data + 3 * k;
+            corner[c] = Vec3{p[0], p[1], p[2]};
+        }
+    }
+    return tris;
+}
+
+std::vector<Triangle> triangle_soup(py::handle triangles) {
+    const FloatRows r = triangle_rows(triangles, "triangles");
+    check_triangle_count(r.rows, "triangles");
+    std::vector<Triangle> tris(r.rows);
+    for (std::size_t t = 0; t < r.rows; ++t)
+        for (std::size_t c = 0; c < 3; ++c) {
+            const float* p = r.data + 9 * t + 3 * c;
+            if (!finite3(p))
+                throw py::value_error("triangles[" + std::to_string(t) + ", " + std::to_string(c) + "] = " +
+                                      vec_text(p) + " is not finite");
+            (&tris[t].v0)[c] = Vec3{p[0], p[1], p[2]};
+        }
+    return tris;
+}
+
+Vec3 vec3_value(py::handle object, const std::string& name) {
+    const py::array a = as_array(object, name);
+    if (a.ndim() != 1 || a.shape(0) != 3) throw py::value_error(name + " must have shape (3,), got " + shape_of(a));
+    check_real(a, name);
+    const float* p = static_cast<const float*>(required(a, "float32", name).data());
+    if (!finite3(p)) throw py::value_error(name + " = " + vec_text(p) + " is not finite");
+    return Vec3{p[0], p[1], p[2]};
+}
+
+unsigned small_count(py::handle object, const std::string& name, unsigned max) {
+    const std::string range = " must be an integer in [0, " + std::to_string(max) + "]";
+    if (py::isinstance<py::bool_>(object) || PyIndex_Check(object.ptr()) == 0)
+        throw py::value_error(name + range + ", got " + py::repr(object).cast<std::string>());
+    const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(object.ptr()));
+    if (!index) throw py::error_already_set();
+    int overflow = 0;
+    const long long value = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+    if (overflow != 0 || value < 0 || value > static_cast<long long>(max))
+        throw py::value_error(name + range + ", got " + py::repr(index).cast<std::string>());
+    return static_cast<unsigned>(value);
+}
+
+std::string text(py::handle object, const std::string& name) {
+    if (!py::isinstance<py::str>(object))
+        throw py::value_error(name + " must be a str, got " + py::repr(object).cast<std::string>());
+    return object.cast<std::string>();
+}
+
+}  // namespace cellrt::python

@@ -1,0 +1,64 @@
+// The module's inputs checked and read: numpy arrays (or anything numpy.asarray accepts) of the
+// shape and kind an argument needs, with every refusal a ValueError naming the argument. Float32
+// C-contiguous aligned arrays are read in place; anything else is converted once, by numpy.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "cellrt/triangle.hpp"
+
+namespace cellrt::python {
+
+namespace py = pybind11;
+
+// Rows of `columns` float32 values, `rows` of them: the argument read in place (`borrowed`) or a
+// float32 copy numpy made of it, held by `array` as long as the view lives.
+struct FloatRows {
+    py::array array;
+    const float* data = nullptr;
+    std::size_t rows = 0;
+    bool borrowed = false;
+};
+
+// `object` as an (N, columns) float array (integers and float64 converted to float32); `name` is the
+// argument's name for messages. Refuses another shape or a dtype that is not a real number; values
+// are the caller's to check (the rays check theirs while they are traced, in one pass).
+FloatRows float_rows(py::handle object, const std::string& name, std::size_t columns);
+
+// The same for an (M, 3, 3) array of triangles.
+FloatRows triangle_rows(py::handle object, const std::string& name);
+
+// A ray bound (tnear, tfar): a scalar for every ray, or one float32 per ray. NaN is refused.
+struct Bound {
+    FloatRows values;      // empty rows: the scalar
+    float scalar = 0.f;
+    bool per_ray() const { return values.data != nullptr; }
+    float at(std::size_t i) const { return per_ray() ? values.data[i] : scalar; }
+};
+Bound ray_bound(py::handle object, const std::string& name, std::size_t rays);
+
+// Triangles from vertices (N, 3) and faces (M, 3) of integers, every index checked against N, every
+// used vertex checked finite.
+std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces);
+
+// Triangles from an (M, 3, 3) array, every coordinate checked finite.
+std::vector<Triangle> triangle_soup(py::handle triangles);
+
+// A point or vector: three finite numbers.
+Vec3 vec3_value(py::handle object, const std::string& name);
+
+// A non-negative integer no larger than `max`, refused as ValueError naming `name` otherwise.
+unsigned small_count(py::handle object, const std::string& name, unsigned max);
+
+// A str argument; ValueError naming `name` for anything else.
+std::string text(py::handle object, const std::string& name);
+
+// The array's shape as Python prints it: "(5, 4)".
+std::string shape_of(const py::array& a);
+
+}  // namespace cellrt::python

@@ -1,0 +1,329 @@
+// The Python module `cellrt` (docs/PYTHON.md): accelerators over numpy triangles, batches of rays
+// traced on all threads without the GIL, scenes and the renderer. A consumer of the public API
+// (cellrt/accel.hpp, cellrt/scene.hpp, cellrt/render.hpp), as the programs are.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <limits>
+#include <memory>
+
+#include "arrays.hpp"
+#include "batch.hpp"
+#include "cellrt/accel.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/render.hpp"
+#include "cellrt/scene.hpp"
+
+namespace cellrt::python {
+namespace {
+
+// An accelerator and what it reads: the kd-tree and brute force read the triangles on every call
+// (cellrt/accel.hpp), so they live as long as it, out of Python's reach.
+struct PyAccelerator {
+    std::vector<Triangle> triangles;
+    std::unique_ptr<Accelerator> accel;
+    Team team;
+};
+
+std::string param_value(py::handle value, const std::string& name) {
+    if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+    if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
+    if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+    throw py::value_error(name + " must be a str, bool, int or float, got " + py::repr(value).cast<std::string>());
+}
+
+// kind "KIND[:TRAVERSAL]", the SIMD set, the build threads and the structure's parameters.
+AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, py::handle params) {
+    const std::string spec = text(kind, "kind");
+    if (spec.find_first_of("+@") != std::string::npos)
+        throw py::value_error("kind '" + spec + "' must be KIND or KIND:TRAVERSAL; pass the SIMD set as simd= and "
+                              "parameters as params=");
+    AccelConfig c = parse_accel_config(spec);
+    c.simd = text(simd, "simd");
+    c.threads = small_count(threads, "threads", kMaxWorkers);
+    if (!py::isinstance<py::dict>(params))
+        throw py::value_error("params must be a dict of name: value, got " + py::repr(params).cast<std::string>());
+    for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(params)) {
+        const std::string name = text(key, "a key of params");
+        c.params[name] = param_value(value, "params['" + name + "']");
+    }
+    return c;
+}
+
+std::unique_ptr<PyAccelerator> build(std::vector<Triangle> triangles, const AccelConfig& config) {
+    auto a = std::make_unique<PyAccelerator>(PyAccelerator{std::move(triangles), nullptr, Team(config.threads)});
+    py::gil_scoped_release unlocked;
+    a->accel = make_accelerator(a->triangles, config);
+    return a;
+}
+
+py::dict py_intersect(const PyAccelerator& a, py::handle origins, py::handle directions, py::handle tnear,
+                   py::handle tfar) {
+    const RayInput in = ray_input(origins, directions, tnear, tfar);
+    const auto n = static_cast<py::ssize_t>(in.count);
+    py::array_t<float> t(n), u(n), v(n);
+    py::array_t<std::int64_t> prim(n);
+    const HitOutput out{t.mutable_data(), prim.mutable_data(), u.mutable_data(), v.mutable_data()};
+    std::size_t invalid;
+    {
+        py::gil_scoped_release unlocked;
+        invalid = intersect(*a.accel, a.team, in, out);
+    }
+    if (invalid != kAllValid) throw py::value_error(invalid_ray_message(in, invalid));
+    py::dict d;
+    d["t"] = t;
+    d["prim"] = prim;
+    d["u"] = u;
+    d["v"] = v;
+    return d;
+}
+
+py::array_t<bool> py_occluded(const PyAccelerator& a, py::handle origins, py::handle directions, py::handle tnear,
+                           py::handle tfar) {
+    const RayInput in = ray_input(origins, directions, tnear, tfar);
+    py::array_t<bool> out(static_cast<py::ssize_t>(in.count));
+    static_assert(sizeof(bool) == sizeof(std::uint8_t));
+    auto* bytes = reinterpret_cast<std::uint8_t*>(out.mutable_data());
+    std::size_t invalid;
+    {
+        py::gil_scoped_release unlocked;
+        invalid = occluded(*a.accel, a.team, in, bytes);
+    }
+    if (invalid != kAllValid) throw py::value_error(invalid_ray_message(in, invalid));
+    return out;
+}
+
+py::tuple vec_tuple(const Vec3& v) { return py::make_tuple(v.x, v.y, v.z); }
+
+// A Vec3 member as a property of three floats, set from any sequence of three finite numbers.
+template <class C>
+void vec_property(py::class_<C>& cls, const char* name, Vec3 C::*member, const char* doc) {
+    cls.def_property(
+        name, [member](const C& c) { return vec_tuple(c.*member); },
+        [member, name](C& c, py::handle value) { c.*member = vec3_value(value, name); }, doc);
+}
+
+std::pair<int, int> image_size(py::handle size) {
+    const auto refuse = [&] {
+        throw py::value_error("size must be (width, height), got " + py::repr(size).cast<std::string>());
+    };
+    if (!py::isinstance<py::sequence>(size) || py::isinstance<py::str>(size)) refuse();
+    const auto seq = py::reinterpret_borrow<py::sequence>(size);
+    if (seq.size() != 2) refuse();
+    const unsigned max = static_cast<unsigned>(kMaxImageSide);
+    const int w = static_cast<int>(small_count(seq[0], "size[0]", max));
+    const int h = static_cast<int>(small_count(seq[1], "size[1]", max));
+    try {
+        check_image_size(w, h);
+    } catch (const Error& e) {
+        throw py::value_error(std::string("size: ") + e.what());
+    }
+    return {w, h};
+}
+
+// The image's pixels as an (H, W, 3) float32 array that owns them (no copy).
+py::array image_array(Image image) {
+    auto* owned = new Image(std::move(image));
+    py::capsule free_image(owned, [](void* p) { delete static_cast<Image*>(p); });
+    return py::array_t<float>({static_cast<py::ssize_t>(owned->height), static_cast<py::ssize_t>(owned->width),
+                               py::ssize_t{3}},
+                              reinterpret_cast<const float*>(owned->pixels.data()), free_image);
+}
+
+py::array render_scene(py::handle scene_object, py::handle kind, py::handle size, py::handle shading,
+                       py::handle threads, py::handle ao_samples) {
+    if (!py::isinstance<Scene>(scene_object))
+        throw py::value_error("scene must be a cellrt.Scene (cellrt.load_scene), got " +
+                              py::repr(scene_object).cast<std::string>());
+    AccelConfig config = accel_config(kind, py::str("auto"), threads, py::dict());
+    if (!config.traversal.empty()) config.simd = "off";  // a single-ray kernel named, as the CLI's --traversal
+    RenderOptions ro;
+    ro.threads = config.threads;
+    try {
+        ro.shading.shading = parse_shading(text(shading, "shading"));
+    } catch (const Error& e) {
+        throw py::value_error(std::string("shading: ") + e.what());
+    }
+    ro.shading.ao_samples = static_cast<int>(small_count(ao_samples, "ao_samples", kMaxAoSamples));
+    if (ro.shading.ao_samples < 1) throw py::value_error("ao_samples must lie in [1, " + std::to_string(kMaxAoSamples) + "]");
+    // A copy: the render runs without the GIL, while Python may change the scene's camera.
+    const Scene scene = scene_object.cast<const Scene&>();
+    std::tie(ro.width, ro.height) = size.is_none() ? std::pair{scene.width, scene.height} : image_size(size);
+    Image image;
+    {
+        py::gil_scoped_release unlocked;
+        const std::unique_ptr<Accelerator> accel = make_accelerator(scene.triangles, config);
+        image = render(scene, *accel, ro);
+    }
+    return image_array(std::move(image));
+}
+
+std::shared_ptr<Scene> load(py::handle path) {
+    py::object p;
+    try {
+        p = py::module_::import("os").attr("fspath")(path);
+    } catch (py::error_already_set&) {
+        throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
+    }
+    const std::string spec = text(p, "path");
+    py::gil_scoped_release unlocked;
+    return std::make_shared<Scene>(load_scene(spec));
+}
+
+py::tuple camera_rays(const Camera& camera, py::handle width, py::handle height) {
+    const auto max = static_cast<unsigned>(kMaxImageSide);
+    const int w = static_cast<int>(small_count(width, "width", max)), h = static_cast<int>(small_count(height, "height", max));
+    const PinholeCamera pinhole(camera, w, h);
+    const auto n = static_cast<py::ssize_t>(w) * h;
+    py::array_t<float> org({n, py::ssize_t{3}}), dir({n, py::ssize_t{3}});
+    float* o = org.mutable_data();
+    float* d = dir.mutable_data();
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Ray r = pinhole.primary(x, y);
+            const std::size_t i = 3 * (static_cast<std::size_t>(y) * w + x);
+            o[i] = r.org.x, o[i + 1] = r.org.y, o[i + 2] = r.org.z;
+            d[i] = r.dir.x, d[i + 1] = r.dir.y, d[i + 2] = r.dir.z;
+        }
+    return py::make_tuple(org, dir);
+}
+
+}  // namespace
+}  // namespace cellrt::python
+
+PYBIND11_MODULE(cellrt, m) {
+    using namespace cellrt;
+    using namespace cellrt::python;
+    m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
+    m.attr("__version__") = CELLRT_VERSION;
+    py::register_exception<Error>(m, "Error", PyExc_ValueError);
+
+    py::class_<TreeReport>(m, "TreeReport", "A tree's build report: its shape, references per triangle, SAH cost")
+        .def_readonly("nodes", &TreeReport::nodes)
+        .def_readonly("inner_nodes", &TreeReport::inner_nodes)
+        .def_readonly("leaves", &TreeReport::leaves)
+        .def_readonly("empty_leaves", &TreeReport::empty_leaves)
+        .def_readonly("empty_space_nodes", &TreeReport::empty_space_nodes, "BIH: inner nodes cutting off empty space")
+        .def_readonly("depth_limit", &TreeReport::depth_limit, "0: none")
+        .def_readonly("max_depth", &TreeReport::max_depth)
+        .def_readonly("mean_leaf_depth", &TreeReport::mean_leaf_depth)
+        .def_readonly("triangles_per_leaf", &TreeReport::triangles_per_leaf)
+        .def_readonly("references_per_triangle", &TreeReport::references_per_triangle)
+        .def_readonly("sah_cost", &TreeReport::sah_cost);
+
+    py::class_<AccelStats>(m, "AccelStats", "What a built accelerator reports (cellrt/accelerator.hpp)")
+        .def_readonly("name", &AccelStats::name, "the kind")
+        .def_readonly("traversal", &AccelStats::traversal, "the single-ray kernel, 'packet' (SIMD packets), or Embree's")
+        .def_readonly("simd_lanes", &AccelStats::simd_lanes, "rays a SIMD packet traces at once; 0: single rays")
+        .def_readonly("build_seconds", &AccelStats::build_seconds)
+        .def_readonly("memory_bytes", &AccelStats::memory_bytes)
+        .def_readonly("triangles", &AccelStats::triangles)
+        .def_readonly("tree", &AccelStats::tree, "TreeReport (kd-tree, BIH) or None")
+        .def_property_readonly(
+            "settings",
+            [](const AccelStats& s) {
+                py::dict d;
+                for (const auto& [k, v] : s.settings) d[py::str(k)] = v;
+                return d;
+            },
+            "the build settings as used, name: value")
+        .def_property_readonly("figures", &AccelStats::figures, "the printed report: (name, value) pairs")
+        .def("__repr__", [](const AccelStats& s) {
+            return "<cellrt.AccelStats " + s.name + ", " + std::to_string(s.triangles) + " triangles, build " +
+                   std::to_string(s.build_seconds) + " s, " + std::to_string(s.memory_bytes) + " bytes>";
+        });
+
+    py::class_<PyAccelerator>(m, "Accelerator",
+                              "An acceleration structure over triangles. intersect() and occluded() may run at once "
+                              "from any number of Python threads; each releases the GIL while it traces.")
+        .def(py::init([](py::handle first, py::handle faces, py::handle kind, py::handle simd, py::handle threads,
+                         py::handle params) {
+                 const AccelConfig config = accel_config(kind, simd, threads, params);
+                 return build(faces.is_none() ? triangle_soup(first) : indexed_triangles(first, faces), config);
+             }),
+             py::arg("vertices"), py::arg("faces") = py::none(), py::kw_only(), py::arg("kind") = "kd",
+             py::arg("simd") = "auto", py::arg("threads") = 0, py::arg("params") = py::dict(),
+             "Accelerator(vertices (N,3), faces (M,3), kind='kd', simd='auto', threads=0, params={}), or "
+             "Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); the GIL is "
+             "released during the build.")
+        .def("intersect", &py_intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0,
+             py::arg("tfar") = std::numeric_limits<double>::infinity(),
+             "Closest hits: dict of arrays t (inf on a miss), prim (int64, -1 on a miss), u, v.")
+        .def("occluded", &py_occluded, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0,
+             py::arg("tfar") = std::numeric_limits<double>::infinity(),
+             "Any hit with tnear <= t <= tfar: a bool array.")
+        .def_property_readonly("stats", [](const PyAccelerator& a) { return a.accel->stats(); },
+                               "AccelStats: build time, memory, the structure's report");
+
+    py::class_<Camera> camera(m, "Camera", "A pinhole camera: position, look_at, up, fov_y_deg (full vertical, degrees)");
+    camera.def(py::init<>());
+    vec_property(camera, "position", &Camera::position, "(x, y, z)");
+    vec_property(camera, "look_at", &Camera::look_at, "(x, y, z)");
+    vec_property(camera, "up", &Camera::up, "(x, y, z)");
+    camera.def_readwrite("fov_y_deg", &Camera::fov_y_deg)
+        .def("rays", &camera_rays, py::arg("width"), py::arg("height"),
+                 "The primary rays of a width x height image, as the renderer casts them: (origins, directions), "
+                 "each (width*height, 3) float32, row-major from the top row.");
+    py::class_<PointLight> light(m, "Light", "A point light: position, color");
+    light.def(py::init<>());
+    vec_property(light, "position", &PointLight::position, "(x, y, z)");
+    vec_property(light, "color", &PointLight::color, "(r, g, b)");
+
+    py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", "Triangles, a camera, a point light and an image size")
+        .def(py::init([](py::handle triangles) {
+                 auto s = std::make_shared<Scene>();
+                 s->name = "numpy";
+                 s->triangles = triangle_soup(triangles);
+                 if (s->triangles.empty()) throw py::value_error("triangles must hold at least one triangle");
+                 set_default_view(*s);
+                 return s;
+             }),
+             py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")
+        .def_readwrite("name", &Scene::name)
+        .def_property_readonly(
+            "triangles",
+            [](py::object self) {
+                Scene& s = self.cast<Scene&>();
+                py::array a(py::dtype::of<float>(), {static_cast<py::ssize_t>(s.triangles.size()), py::ssize_t{3}, py::ssize_t{3}},
+                            {py::ssize_t{sizeof(Triangle)}, py::ssize_t{sizeof(Vec3)}, py::ssize_t{sizeof(float)}},
+                            reinterpret_cast<const float*>(s.triangles.data()), self);
+                a.attr("setflags")(py::arg("write") = false);
+                return a;
+            },
+            "(M, 3, 3) float32, a read-only view of the scene's own triangles")
+        .def_readwrite("camera", &Scene::camera)
+        .def_readwrite("light", &Scene::light)
+        .def_property(
+            "size", [](const Scene& s) { return py::make_tuple(s.width, s.height); },
+            [](Scene& s, py::handle size) { std::tie(s.width, s.height) = image_size(size); }, "(width, height)")
+        .def("__repr__", [](const Scene& s) {
+            return "<cellrt.Scene '" + s.name + "', " + std::to_string(s.triangles.size()) + " triangles, " +
+                   std::to_string(s.width) + "x" + std::to_string(s.height) + ">";
+        });
+
+    m.def("load_scene", &load, py::arg("path"),
+          "A view file (.json), a mesh (.obj, .ply, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "
+          "cellrt.Error with the library's message naming the file and line.");
+    m.def("render", &render_scene, py::arg("scene"), py::kw_only(), py::arg("kind") = "kd",
+          py::arg("size") = py::none(), py::arg("shading") = "direct", py::arg("threads") = 0, py::arg("ao_samples") = 4,
+          "The scene rendered as cellrt render renders it: an (H, W, 3) float32 array, the values of its PFM, row 0 "
+          "at the top.");
+    m.def("kinds", &accelerator_kinds, "The accelerator kinds of this build.");
+
+    // For the tests and the benchmark.
+    m.def("_reads_in_place", [](py::handle array) { return float_rows(array, "array", 3).borrowed; });
+    m.def(
+        "_native_intersect_seconds",
+        [](const PyAccelerator& a, py::handle origins, py::handle directions, int repeats, py::handle clock) {
+            const std::string which = text(clock, "clock");
+            if (which != "wall" && which != "cpu") throw py::value_error("clock must be 'wall' or 'cpu'");
+            const RayInput in = ray_input(origins, directions, py::float_(0.0),
+                                          py::float_(std::numeric_limits<double>::infinity()));
+            py::gil_scoped_release unlocked;
+            return native_intersect_seconds(*a.accel, a.team, in, repeats, which == "cpu");
+        },
+        py::arg("accelerator"), py::arg("origins"), py::arg("directions"), py::arg("repeats"), py::arg("clock") = "wall");
+}

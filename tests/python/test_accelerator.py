@@ -1,0 +1,186 @@
+"""Every kind and instruction set from Python against brute force, bit for bit; the two ways to give
+triangles; conversions and the zero-copy path; threads, concurrency and the GIL; the statistics."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import cellrt
+from conftest import probe_rays
+
+# Embree answers up to rounding (docs/EMBREE.md): compared apart, with a tolerance.
+KINDS = [k for k in cellrt.kinds() if k not in ("brute", "embree")]
+SIMD = ["off", "auto", "portable"]
+
+
+def assert_same_hits(a, b):
+    assert np.array_equal(a["prim"], b["prim"])
+    for key in ("t", "u", "v"):
+        assert np.array_equal(a[key].view(np.int32), b[key].view(np.int32)), key
+
+
+@pytest.fixture(scope="module", params=["city", "spheres"])
+def case(request):
+    scene = request.getfixturevalue(request.param)
+    rays = probe_rays(scene, 20000, seed=11)
+    brute = cellrt.Accelerator(scene.triangles, kind="brute", simd="off")
+    return scene, rays, brute.intersect(*rays), brute.occluded(*rays)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("simd", SIMD)
+def test_every_kind_finds_the_brute_force_hit(case, kind, simd):
+    scene, rays, hits, occluded = case
+    acc = cellrt.Accelerator(scene.triangles, kind=kind, simd=simd)
+    assert_same_hits(acc.intersect(*rays), hits)
+    assert np.array_equal(acc.occluded(*rays), occluded)
+
+
+@pytest.mark.skipif("embree" not in cellrt.kinds(), reason="built without Embree 3")
+def test_embree_agrees_up_to_rounding(city):
+    o, d = city.camera.rays(128, 128)
+    ref = cellrt.Accelerator(city.triangles, kind="brute").intersect(o, d)
+    got = cellrt.Accelerator(city.triangles, kind="embree").intersect(o, d)
+    same = got["prim"] == ref["prim"]
+    assert same.mean() > 0.999
+    hit = same & (ref["prim"] >= 0)
+    assert np.allclose(got["t"][hit], ref["t"][hit], rtol=1e-5, atol=0)
+
+
+def test_the_probe_rays_hit_and_miss(case):
+    _, _, hits, occluded = case
+    hit = hits["prim"] >= 0
+    assert 0.2 < hit.mean() < 0.95
+    assert np.all(np.isinf(hits["t"][~hit])) and np.all(hits["u"][~hit] == 0)
+    assert hits["prim"].dtype == np.int64 and occluded.dtype == np.bool_
+    assert np.array_equal(occluded[hit], np.ones(hit.sum(), bool))
+
+
+def test_single_ray_traversals(case):
+    scene, rays, hits, _ = case
+    for kind in ("kd:rec", "kd:branchless", "bih:branchless"):
+        assert_same_hits(cellrt.Accelerator(scene.triangles, kind=kind, simd="off").intersect(*rays), hits)
+
+
+def test_indexed_mesh_equals_triangle_soup(city):
+    tris = np.asarray(city.triangles)
+    vertices, faces = np.unique(tris.reshape(-1, 3), axis=0, return_inverse=True)
+    faces = faces.reshape(-1, 3)
+    rays = probe_rays(city, 5000, seed=2)
+    a = cellrt.Accelerator(vertices, faces.astype(np.int32)).intersect(*rays)
+    b = cellrt.Accelerator(tris).intersect(*rays)
+    c = cellrt.Accelerator(vertices.astype(np.float64), faces.astype(np.uint64)).intersect(*rays)
+    assert_same_hits(a, b)
+    assert_same_hits(a, c)
+
+
+def test_float64_and_strided_input_give_the_same_hits(city):
+    acc = cellrt.Accelerator(city.triangles)
+    o, d, tn, tf = probe_rays(city, 5000, seed=3)
+    ref = acc.intersect(o, d, tn, tf)
+    assert_same_hits(acc.intersect(o.astype(np.float64), d.astype(np.float64), tn.astype(np.float64), tf), ref)
+    wide = np.zeros((len(o), 6), np.float32)
+    wide[:, :3], wide[:, 3:] = o, d
+    assert_same_hits(acc.intersect(wide[:, :3], wide[:, 3:], tn, tf), ref)
+    assert_same_hits(acc.intersect(o.tolist(), d.tolist(), tn.tolist(), tf.tolist()), ref)
+
+
+def test_contiguous_float32_is_read_in_place():
+    a = np.zeros((10, 3), np.float32)
+    assert cellrt._reads_in_place(a)
+    assert not cellrt._reads_in_place(a.astype(np.float64))
+    assert not cellrt._reads_in_place(np.zeros((10, 6), np.float32)[:, :3])
+    assert not cellrt._reads_in_place(np.asfortranarray(np.zeros((10, 3), np.float32)))
+    assert not cellrt._reads_in_place(a.tolist())
+
+
+def test_scalar_and_array_bounds_agree(city):
+    acc = cellrt.Accelerator(city.triangles)
+    o, d, _, _ = probe_rays(city, 3000, seed=4)
+    n = len(o)
+    assert_same_hits(acc.intersect(o, d, 0.5, 40.0), acc.intersect(o, d, np.full(n, 0.5), np.full(n, 40.0)))
+    near = acc.intersect(o, d)
+    far = acc.intersect(o, d, tnear=near["t"][np.isfinite(near["t"])].max() * 2)
+    assert np.all(far["prim"] == -1)
+    assert np.array_equal(acc.occluded(o, d, tfar=np.where(near["prim"] >= 0, near["t"], np.inf)), near["prim"] >= 0)
+
+
+def test_threads_and_batch_sizes_do_not_change_hits(city):
+    o, d, tn, tf = probe_rays(city, 10000, seed=5)
+    ref = cellrt.Accelerator(city.triangles, threads=1).intersect(o, d, tn, tf)
+    acc = cellrt.Accelerator(city.triangles, threads=0)
+    assert_same_hits(acc.intersect(o, d, tn, tf), ref)
+    for n in (0, 1, 1023, 1024, 1025, 3000):
+        part = acc.intersect(o[:n], d[:n], tn[:n], tf[:n])
+        assert len(part["t"]) == n
+        assert np.array_equal(part["prim"], ref["prim"][:n])
+
+
+def test_concurrent_calls_from_python_threads(city):
+    acc = cellrt.Accelerator(city.triangles)
+    rays = probe_rays(city, 20000, seed=6)
+    ref = acc.intersect(*rays)
+    results = [None] * 4
+
+    def work(i):
+        results[i] = acc.intersect(*rays)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        assert_same_hits(r, ref)
+
+
+def test_the_gil_is_released_while_tracing():
+    scene = cellrt.load_scene("builtin:forest?tris=50000&seed=1")
+    acc = cellrt.Accelerator(scene.triangles, simd="off", threads=1)
+    o, d = scene.camera.rays(1024, 1024)
+    start = time.perf_counter()
+    acc.intersect(o, d)
+    alone = time.perf_counter() - start
+    worker = threading.Thread(target=acc.intersect, args=(o, d))
+    gaps, last = [], time.perf_counter()
+    worker.start()
+    while worker.is_alive():
+        now = time.perf_counter()
+        gaps.append(now - last)
+        last = now
+    worker.join()
+    # Held, the GIL would stall this loop for the whole trace.
+    assert max(gaps) < 0.5 * alone, (max(gaps), alone)
+
+
+def test_stats_are_typed(city):
+    kd = cellrt.Accelerator(city.triangles, kind="kd", params={"leaf_size": 2, "method": "binned", "bins": 64}).stats
+    assert kd.name == "kd" and kd.triangles == len(city.triangles)
+    assert kd.build_seconds > 0 and kd.memory_bytes > 0
+    assert kd.traversal == "packet" and kd.simd_lanes in (4, 8, 16)
+    assert kd.tree.nodes == kd.tree.inner_nodes + kd.tree.leaves and kd.tree.sah_cost > 0
+    assert kd.settings["method"] == "binned"
+    assert ("triangles", str(len(city.triangles))) in kd.figures
+    bih = cellrt.Accelerator(city.triangles, kind="bih", simd="off").stats
+    assert bih.simd_lanes == 0 and bih.tree.empty_space_nodes is not None
+    assert cellrt.Accelerator(city.triangles, kind="brute").stats.tree is None
+
+
+def test_empty_mesh_and_empty_batch():
+    acc = cellrt.Accelerator(np.zeros((0, 3, 3), np.float32))
+    r = acc.intersect(np.zeros((2, 3)), np.ones((2, 3)))
+    assert np.array_equal(r["prim"], [-1, -1])
+    empty = acc.intersect(np.zeros((0, 3)), np.zeros((0, 3)))
+    assert all(len(v) == 0 for v in empty.values())
+    assert acc.occluded(np.zeros((0, 3)), np.zeros((0, 3))).shape == (0,)
+
+
+def test_degenerate_rays_miss():
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], np.float32)
+    acc = cellrt.Accelerator(tri)
+    o = np.array([[0.2, 0.2, 1], [0.2, 0.2, 1], [0.2, 0.2, 1]], np.float32)
+    d = np.array([[0, 0, -1], [0, 0, 0], [0, 0, -1]], np.float32)
+    r = acc.intersect(o, d, tnear=np.array([0, 0, 2], np.float32))
+    assert r["prim"].tolist() == [0, -1, -1]
+    assert r["t"][0] == 1.0 and abs(r["u"][0] - 0.2) < 1e-6 and abs(r["v"][0] - 0.2) < 1e-6

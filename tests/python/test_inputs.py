@@ -1,0 +1,172 @@
+"""Every bad input: a ValueError naming the argument (shape, dtype, index out of range, lengths that
+differ, NaN and infinity), library refusals as cellrt.Error with the library's message; never a crash."""
+import numpy as np
+import pytest
+
+import cellrt
+
+TRI = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], np.float32)
+O = np.array([[0.2, 0.2, 1.0]] * 4, np.float32)
+D = np.array([[0.0, 0.0, -1.0]] * 4, np.float32)
+
+
+@pytest.fixture(scope="module")
+def acc():
+    return cellrt.Accelerator(TRI)
+
+
+def refused(match, call, *args, **kwargs):
+    with pytest.raises(ValueError, match=match):
+        call(*args, **kwargs)
+
+
+def test_library_errors_are_value_errors_with_the_library_message():
+    assert issubclass(cellrt.Error, ValueError)
+    with pytest.raises(cellrt.Error, match=r"unknown accelerator 'octree' \(choose one of: brute, kd"):
+        cellrt.Accelerator(TRI, kind="octree")
+    with pytest.raises(cellrt.Error, match="unknown kd parameter"):
+        cellrt.Accelerator(TRI, params={"nonsense": 1})
+    with pytest.raises(cellrt.Error, match="leaf_size"):
+        cellrt.Accelerator(TRI, params={"leaf_size": -4})
+    with pytest.raises(cellrt.Error, match="traversal"):
+        cellrt.Accelerator(TRI, kind="kd:zigzag", simd="off")
+    with pytest.raises(cellrt.Error, match="neon"):
+        cellrt.Accelerator(TRI, simd="neon")
+
+
+@pytest.mark.parametrize("triangles,match", [
+    (np.zeros((2, 3)), r"triangles must have shape \(M, 3, 3\), got \(2, 3\) \(vertices of shape \(N, 3\) need faces\)"),
+    (np.zeros((2, 3, 2)), r"triangles must have shape \(M, 3, 3\), got \(2, 3, 2\)"),
+    (np.zeros(5), r"triangles must have shape"),
+    (np.zeros((1, 3, 3), complex), "triangles must hold real numbers, got dtype complex128"),
+    (np.zeros((1, 3, 3), bool), "triangles must hold real numbers, got dtype bool"),
+    (np.array([[[0, 0, 0], [1, np.nan, 0], [0, 1, 0]]]), r"triangles\[0, 1\] = \(1.0, nan, 0.0\) is not finite"),
+    (np.array([[[0, 0, 0], [1, 0, 0], [0, np.inf, 0]]]), r"triangles\[0, 2\] .* is not finite"),
+    (np.array([[[0, 0, 0], [1, 0, 0], [0, 1e39, 0]]]), r"triangles\[0, 2\] .* is not finite"),
+    ("abc", "triangles must have shape"),
+    ([[[0, 0, 0], [1, 0]]], "triangles is not an array"),
+    (None, "triangles must have shape"),
+])
+def test_bad_triangles(triangles, match):
+    with np.errstate(over="ignore"):
+        refused(match, cellrt.Accelerator, triangles)
+
+
+V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+
+
+@pytest.mark.parametrize("vertices,faces,match", [
+    (V, [[0, 1, 3]], r"faces\[0, 2\] = 3 is out of range for 3 vertices"),
+    (V, [[0, 1, 2], [0, -1, 2]], r"faces\[1, 1\] = -1 is out of range for 3 vertices"),
+    (V, np.array([[0, 1, 2]], np.float32), "faces must hold integers, got dtype float32"),
+    (V, np.array([[0, 1, 2]], bool), "faces must hold integers, got dtype bool"),
+    (V, [[0, 1]], r"faces must have shape \(M, 3\), got \(1, 2\)"),
+    (V, [0, 1, 2], r"faces must have shape \(M, 3\), got \(3,\)"),
+    (V[:, :2], [[0, 1, 2]], r"vertices must have shape \(N, 3\), got \(3, 2\)"),
+    (np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]]), [[0, 1, 2]], r"vertices\[1\] = \(nan, 0.0, 0.0\) is not finite"),
+    (V.astype(str), [[0, 1, 2]], "vertices must hold real numbers"),
+    (np.zeros((3, 3, 3)), [[0, 1, 2]], r"vertices must have shape \(N, 3\)"),
+])
+def test_bad_indexed_mesh(vertices, faces, match):
+    refused(match, cellrt.Accelerator, vertices, faces)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"kind": 3}, "kind must be a str, got 3"),
+    ({"kind": "kd+avx2"}, "pass the SIMD set as simd="),
+    ({"kind": "kd@leaf_size=2"}, "parameters as params="),
+    ({"simd": None}, "simd must be a str, got None"),
+    ({"threads": -1}, r"threads must be an integer in \[0, 1024\], got -1"),
+    ({"threads": 2.5}, r"threads must be an integer in \[0, 1024\], got 2.5"),
+    ({"threads": True}, "threads must be an integer"),
+    ({"threads": 10**30}, "threads must be an integer"),
+    ({"threads": 5000}, r"got 5000"),
+    ({"params": [("leaf_size", 2)]}, "params must be a dict"),
+    ({"params": {1: 2}}, "a key of params must be a str, got 1"),
+    ({"params": {"leaf_size": [2]}}, r"params\['leaf_size'\] must be a str, bool, int or float"),
+])
+def test_bad_options(kwargs, match):
+    refused(match, cellrt.Accelerator, TRI, **kwargs)
+
+
+def test_numpy_integers_are_accepted_as_counts():
+    assert cellrt.Accelerator(TRI, threads=np.int64(1)).stats.triangles == 1
+
+
+@pytest.mark.parametrize("method", ["intersect", "occluded"])
+@pytest.mark.parametrize("args,kwargs,match", [
+    ((O[:3], D), {}, "origins has 3 rays, directions 4"),
+    ((O[:, :2], D), {}, r"origins must have shape \(N, 3\), got \(4, 2\)"),
+    ((O, D.reshape(-1)), {}, r"directions must have shape \(N, 3\), got \(12,\)"),
+    ((O, D.astype(complex)), {}, "directions must hold real numbers, got dtype complex128"),
+    ((O, "x"), {}, "directions must have shape"),
+    ((O, [[1, 2, 3], [1, 2]]), {}, "directions is not an array"),
+    ((np.where([[True], [False], [False], [False]], np.nan, O), D), {}, r"origins\[0\] is not finite"),
+    ((O, np.where([[False], [False], [True], [False]], np.inf, D)), {}, r"directions\[2\] is not finite"),
+    ((O, D), {"tnear": np.nan}, "tnear is NaN"),
+    ((O, D), {"tfar": float("nan")}, "tfar is NaN"),
+    ((O, D), {"tfar": [1, 2, np.nan, 4]}, r"tfar\[2\] is NaN"),
+    ((O, D), {"tnear": [0, np.nan, 0, 0]}, r"tnear\[1\] is NaN"),
+    ((O, D), {"tnear": np.zeros(3)}, "tnear has 3 values for 4 rays"),
+    ((O, D), {"tfar": np.zeros((4, 1))}, r"tfar must be a scalar or have shape \(N,\), got \(4, 1\)"),
+    ((O, D), {"tfar": "far"}, "tfar must hold real numbers"),
+    ((O, D), {"tnear": None}, "tnear must hold real numbers"),
+])
+def test_bad_rays(acc, method, args, kwargs, match):
+    refused(match, getattr(acc, method), *args, **kwargs)
+
+
+def test_the_first_bad_ray_is_named(acc):
+    o = np.tile(O, (3000, 1))
+    o[2500], o[1500] = np.nan, np.inf
+    refused(r"origins\[1500\] is not finite", acc.intersect, o, np.tile(D, (3000, 1)))
+
+
+def test_infinite_bounds_and_degenerate_rays_are_valid(acc):
+    r = acc.intersect(O, D, tnear=-np.inf, tfar=np.inf)
+    assert r["prim"].tolist() == [0, 0, 0, 0]
+    assert acc.intersect(O, D, tnear=5.0, tfar=1.0)["prim"].tolist() == [-1] * 4
+
+
+def test_bad_scene_files(tmp_path):
+    with pytest.raises(cellrt.Error, match="no such file"):
+        cellrt.load_scene(tmp_path / "missing.obj")
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")
+    with pytest.raises(cellrt.Error, match=rf"{bad}:2:"):
+        cellrt.load_scene(str(bad))
+    with pytest.raises(cellrt.Error, match="builtin"):
+        cellrt.load_scene("builtin:nothing")
+    refused("path must be a str or os.PathLike, got 3", cellrt.load_scene, 3)
+    refused("path must be a str", cellrt.load_scene, b"x.obj")
+
+
+def test_bad_render_arguments(tmp_path):
+    scene = cellrt.Scene(TRI)
+    refused("scene must be a cellrt.Scene", cellrt.render, "builtin:city")
+    refused("shading: ", cellrt.render, scene, shading="phong")
+    refused(r"size must be \(width, height\), got 64", cellrt.render, scene, size=64)
+    refused(r"size must be \(width, height\), got '64x64'", cellrt.render, scene, size="64x64")
+    refused(r"size\[0\] must be an integer", cellrt.render, scene, size=(-1, 5))
+    refused(r"size: image size 0x5", cellrt.render, scene, size=(0, 5))
+    refused(r"size: image size 65536x65536", cellrt.render, scene, size=(65536, 65536))
+    refused(r"ao_samples must lie in \[1, 64\]", cellrt.render, scene, shading="ao", ao_samples=0)
+    refused(r"ao_samples must be an integer in \[0, 64\], got 65", cellrt.render, scene, shading="ao", ao_samples=65)
+    with pytest.raises(cellrt.Error, match="unknown accelerator"):
+        cellrt.render(scene, kind="octree", size=(8, 8))
+    scene.camera.look_at = scene.camera.position
+    with pytest.raises(cellrt.Error, match="camera"):
+        cellrt.render(scene, size=(8, 8))
+
+
+def test_bad_scene_properties():
+    scene = cellrt.Scene(TRI)
+    refused(r"position must have shape \(3,\), got \(2,\)", setattr, scene.camera, "position", (1, 2))
+    refused(r"up = \(0.0, nan, 0.0\) is not finite", setattr, scene.camera, "up", (0, np.nan, 0))
+    refused("color must hold real numbers", setattr, scene.light, "color", ("r", "g", "b"))
+    refused(r"size\[1\] must be an integer", setattr, scene, "size", (5, 2.5))
+    refused("triangles must hold at least one triangle", cellrt.Scene, np.zeros((0, 3, 3)))
+    with pytest.raises(ValueError):
+        scene.triangles[0, 0, 0] = 5.0
+    with pytest.raises(cellrt.Error, match="image size 0x4"):
+        scene.camera.rays(0, 4)
