@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -270,10 +271,13 @@ inline const ReferenceAnswers& cached_reference(const std::string& key, std::spa
     const std::vector<Ray> rays = RaySuite(tris, RaySuiteOptions{}).rays();
     const std::uint64_t h = detail::fnv1a(rays.data(), rays.size() * sizeof(Ray),
                                           detail::fnv1a(tris.data(), tris.size_bytes()));
-    std::filesystem::create_directories(CELLRT_TEST_CACHE);
+    // CELLRT_TEST_CACHE in the environment moves the cache (the test program run from a bundle).
+    const char* env_dir = std::getenv("CELLRT_TEST_CACHE");
+    const std::string dir = env_dir ? env_dir : CELLRT_TEST_CACHE;
+    std::filesystem::create_directories(dir);
     char name[32];
     std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(h));
-    const std::string path = std::string(CELLRT_TEST_CACHE) + "/" + name + ".ref";
+    const std::string path = dir + "/" + name + ".ref";
     // One process computes, the others wait for its file.
     const int lock_fd = ::open((path + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
     if (lock_fd >= 0) ::flock(lock_fd, LOCK_EX);
