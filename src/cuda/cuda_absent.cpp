@@ -6,7 +6,7 @@
 
 namespace cellrt {
 namespace {
-constexpr const char* kAbsent = "this cellrt was built without CUDA (nvcc was not found when it was configured)";
+constexpr const char* kAbsent = "this cellrt was built without CUDA: no nvcc, or CELLRT_CUDA=OFF, when it was configured";
 }
 
 DeviceInfo cuda_device_info() {
