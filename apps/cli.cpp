@@ -21,7 +21,7 @@ std::string scene_help() {
     return "Scene: VIEW.json, MESH.obj, MESH.ply, SCENE.gltf, SCENE.glb, or builtin:NAME[?tris=N&seed=S] (" + names + ")";
 }
 
-void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {
+void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
     std::string kinds;
     for (const auto& k : accelerator_kinds()) kinds += (kinds.empty() ? "" : "|") + k;
     if (kind_optional) kind.clear();
@@ -33,6 +33,10 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional) {
                       ->capture_default_str();
     cmd.add_option("-P,--param", params, "Build parameter NAME=VALUE (repeatable; docs/KDTREE.md, docs/BIH.md)");
     cmd.add_option("--threads", threads, "Worker and build threads (0: all cores)")->capture_default_str();
+    if (with_device)
+        cmd.add_option("--device", device, "Where rays are traced: cpu, or cuda (kd and bih on the GPU; docs/GPU.md)")
+            ->check(CLI::IsMember({"cpu", "cuda"}))
+            ->capture_default_str();
 }
 
 AccelConfig AccelOptions::config() const {
@@ -40,7 +44,9 @@ AccelConfig AccelOptions::config() const {
     AccelConfig c;
     c.kind = kind;
     c.traversal = traversal;
-    c.simd = !traversal.empty() && simd_option && simd_option->count() == 0 ? "off" : simd;
+    const bool simd_given = simd_option && simd_option->count() > 0;
+    c.simd = (!traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
+    c.device = device;
     c.threads = threads;
     for (const std::string& p : params) {
         const auto eq = p.find('=');

@@ -34,17 +34,18 @@ extern std::atomic<bool> g_cancel;
 std::string scene_help();
 
 // --accel, --traversal, --simd, -P NAME=VALUE and --threads, shared by every command that builds a
-// structure. SIMD packets are the default; naming a --traversal (a single-ray kernel) without --simd
-// turns them off.
+// structure, and --device where the command offers the GPU. SIMD packets are the default; naming a
+// --traversal (a single-ray kernel) or --device cuda without --simd turns them off.
 struct AccelOptions {
     std::string kind = "kd";
     std::string traversal;
     std::string simd = "auto";
+    std::string device = "cpu";
     std::vector<std::string> params;
     unsigned threads = 0;
     CLI::Option* simd_option = nullptr;
 
-    void add_to(CLI::App& cmd, bool kind_optional);
+    void add_to(CLI::App& cmd, bool kind_optional, bool with_device = false);
     AccelConfig config() const;
 };
 

@@ -3,6 +3,7 @@
 // traversals, from the table that validates them.
 #include <cstdio>
 
+#include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
@@ -31,6 +32,23 @@ void print_scene(const Scene& scene, double load_seconds) {
     std::printf("image            %dx%d\n", scene.width, scene.height);
 }
 
+// `info --device cuda`: the GPU's name and figures, or one line saying there is none.
+bool print_device() {
+    const DeviceInfo d = cuda_device_info();
+    if (!d.present) {
+        std::printf("cuda: no device (%s)\n", d.reason.c_str());
+        return false;
+    }
+    std::printf("cuda             %s, compute capability %d.%d, %d multiprocessors, %.1f GiB, %zu KiB shared "
+                "memory per block\n",
+                d.name.c_str(), d.compute_major, d.compute_minor, d.multiprocessors,
+                static_cast<double>(d.memory_bytes) / (1024.0 * 1024.0 * 1024.0), d.shared_memory_per_block / 1024);
+    return true;
+}
+
+// The exit status of `info --device cuda` when there is no device, apart from errors' 1 (docs/GPU.md).
+constexpr int kNoDevice = 3;
+
 }  // namespace
 
 Runner add_info(CLI::App& app) {
@@ -44,13 +62,17 @@ Runner add_info(CLI::App& app) {
     cmd->add_option("scene", o->scene, scene_help());
     cmd->add_option("--params", o->params, "Print the build parameters and traversals of this structure, then stop")
         ->check(CLI::IsMember(accelerator_kinds()));
-    o->accel.add_to(*cmd, true);
+    o->accel.add_to(*cmd, true, true);
     return [o] {
         if (!o->params.empty()) {
             print_params(o->params);
             return 0;
         }
-        if (o->scene.empty()) throw Error("info: give a scene, or --params KIND");
+        if (o->accel.device == "cuda" && !print_device()) return kNoDevice;
+        if (o->scene.empty()) {
+            if (o->accel.device == "cuda") return 0;
+            throw Error("info: give a scene, --params KIND or --device cuda");
+        }
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         print_scene(scene, load_timer.seconds());

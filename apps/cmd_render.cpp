@@ -166,7 +166,7 @@ Runner add_render(CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* cmd = app.add_subcommand("render", "Render a scene to an image (primary rays and those their shading casts)");
     cmd->add_option("scene", o->scene, scene_help())->capture_default_str();
-    o->accel.add_to(*cmd, false);
+    o->accel.add_to(*cmd, false, true);
     cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's)");
     cmd->add_option("-o,--output", o->out, "Output image: .png (sRGB) or .pfm (exact floats)")->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace the output file if it exists");
@@ -210,6 +210,9 @@ Runner add_render(CLI::App& app) {
         ro.pin = o->pin;
         ro.cancel = &g_cancel;
         std::unique_ptr<LocalStoreAccelerator> modelled;
+        if (o->local_store.enabled && o->accel.device != "cpu")
+            throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
+                        o->accel.device);
         if (o->local_store.enabled) {
             // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
             AccelConfig config = o->accel.config();

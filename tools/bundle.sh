@@ -3,7 +3,7 @@
 # Embree, stb, ...) into one folder, for a machine of the same architecture where the packages of
 # packages.txt are not installed and cannot be (a cluster node, a lent benchmark machine):
 #
-#   tools/bundle.sh DIR              # after a build; DIR must not exist yet
+#   tools/bundle.sh DIR [PROGRAM...] # after a build; DIR must not exist yet; PROGRAMs: more built programs
 #   DIR/run cellrt_scaling --scenes-dir /path/to/scenes ...    # on the other machine
 #
 # DIR/run PROGRAM ARGS runs DIR/bin/PROGRAM with DIR/lib first on the library path. The programs are
@@ -12,8 +12,8 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${CELLRT_BUILD:-$root/build}"
-if [[ $# -ne 1 ]]; then
-  echo "usage: tools/bundle.sh DIR   (the build is read from ${build}; CELLRT_BUILD names another)" >&2
+if [[ $# -lt 1 ]]; then
+  echo "usage: tools/bundle.sh DIR [PROGRAM...]   (the build is read from ${build}; CELLRT_BUILD names another)" >&2
   exit 2
 fi
 dir="$1"
@@ -21,7 +21,7 @@ if [[ -e "$dir" ]]; then
   echo "tools/bundle.sh: $dir exists; name a new folder" >&2
   exit 1
 fi
-programs=("$build/cellrt" "$build/bench/cellrt_scaling" "$build/bench/cellrt_bench")
+programs=("$build/cellrt" "$build/bench/cellrt_scaling" "$build/bench/cellrt_bench" "${@:2}")
 for p in "${programs[@]}"; do
   if [[ ! -x "$p" ]]; then
     echo "tools/bundle.sh: $p is missing: build first (cmake --build $build)" >&2

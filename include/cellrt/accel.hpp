@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellrt/accelerator.hpp"
+#include "cellrt/device.hpp"
 #include "cellrt/params.hpp"
 
 namespace cellrt {
@@ -21,7 +22,14 @@ namespace cellrt {
 // reordered copy, the wide BVH copies the triangles into its leaves and Embree into its own buffers,
 // so those need `triangles` only during the call. Code that may build any kind keeps the triangles
 // alive and unchanged as long as the accelerator. Hits name triangles by their index in `triangles`.
+// config.device "cuda" builds the device accelerator below; any other device than "cpu" is refused.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
+
+// The tree `config.kind` built on the host and traced on the CUDA device (cellrt/device.hpp; config.device
+// is not read). Throws cellrt::Error, besides make_accelerator's reasons, for a kind that is not a tree,
+// SIMD packets (simd other than "off"), a build without CUDA, or no device (naming CUDA's reason).
+// It keeps nothing of `triangles`: the tree and its triangles are copied to the device.
+std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
 
 // An accelerator configuration written as one string, as the benchmarks and tests name them:
 // KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd:rec", "bih+avx2", "kd+auto@leaf_size=2,bins=64".

@@ -47,6 +47,9 @@ struct AccelConfig {
     std::string simd = "off";
     unsigned threads = 0;      // build threads; 0: all hardware threads
     std::map<std::string, std::string> params;  // the structure's build parameters (its ParamTable)
+    // Where the rays are traced: "cpu", or "cuda" (the trees' single-ray kernels on the GPU, with simd
+    // "off"; cellrt/device.hpp, docs/GPU.md).
+    std::string device = "cpu";
 };
 
 // A tree's build report (Mitsuba's build statistics): its shape, how often triangles are referenced,

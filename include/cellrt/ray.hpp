@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "cellrt/host_device.hpp"
 #include "cellrt/vec.hpp"
 
 namespace cellrt {
@@ -31,22 +32,22 @@ struct Hit {
     std::uint32_t prim = kNoHit;  // triangle index, kNoHit for a miss
     float u = 0.f, v = 0.f;       // barycentrics: point = (1-u-v)*v0 + u*v1 + v*v2
 
-    bool is_hit() const { return prim != kNoHit; }
+    CELLRT_HD bool is_hit() const { return prim != kNoHit; }
     friend bool operator==(const Hit&, const Hit&) = default;
 };
 static_assert(sizeof(Hit) == 16);
 
 // True when (t, prim) is preferred to `best` under the hit rule (ties: lower index).
-inline bool closer(float t, std::uint32_t prim, const Hit& best) {
+CELLRT_HD inline bool closer(float t, std::uint32_t prim, const Hit& best) {
     return t < best.t || (t == best.t && prim < best.prim);
 }
 
-[[gnu::always_inline]] inline bool is_valid(const Ray& r) {
+[[gnu::always_inline]] CELLRT_HD inline bool is_valid(const Ray& r) {
     return is_finite(r.org) && is_finite(r.dir) && !(r.dir == Vec3{}) && !(r.tnear > r.tfar) &&
            r.tnear == r.tnear && r.tfar == r.tfar;
 }
 
 // The initial best of a closest-hit query: nothing found, any t up to tfar still admissible.
-inline Hit miss_for(const Ray& r) { return Hit{r.tfar, kNoHit, 0.f, 0.f}; }
+CELLRT_HD inline Hit miss_for(const Ray& r) { return Hit{r.tfar, kNoHit, 0.f, 0.f}; }
 
 }  // namespace cellrt

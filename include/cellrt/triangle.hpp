@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "cellrt/box.hpp"
+#include "cellrt/host_device.hpp"
 #include "cellrt/ray.hpp"
 
 namespace cellrt {
@@ -24,14 +25,14 @@ namespace cellrt {
 struct Triangle {
     Vec3 v0, v1, v2;
 
-    Box3 bounds() const {
+    CELLRT_HD Box3 bounds() const {
         Box3 b;
         b.extend(v0);
         b.extend(v1);
         b.extend(v2);
         return b;
     }
-    Vec3 geometric_normal() const { return cross(v1 - v0, v2 - v0); }
+    CELLRT_HD Vec3 geometric_normal() const { return cross(v1 - v0, v2 - v0); }
     friend bool operator==(const Triangle&, const Triangle&) = default;
 };
 static_assert(sizeof(Triangle) == 36);
@@ -46,7 +47,7 @@ struct WatertightRay {
     int kx = 0, ky = 1, kz = 2;
     float sx = 0.f, sy = 0.f, sz = 0.f;
 
-    explicit WatertightRay(const Ray& r) : org(r.org) {
+    CELLRT_HD explicit WatertightRay(const Ray& r) : org(r.org) {
         kz = max_axis(r.dir);
         kx = kz == 2 ? 0 : kz + 1;
         ky = kx == 2 ? 0 : kx + 1;
@@ -62,7 +63,7 @@ struct WatertightRay {
 // (det == 0: zero area, or seen edge-on). Always inlined, as the per-ray set-up of the traversals
 // (kernel/traversal.hpp): a unit that instantiates many kernels exhausts GCC's inlining budget,
 // and an out-of-line call costs a kernel up to a tenth of its instructions (docs/BENCHMARKS.md).
-[[gnu::always_inline]] inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+[[gnu::always_inline]] CELLRT_HD inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     // The vertices' coordinates in ray order (x, y, z of v0, v1, v2: the nine floats of the
     // triangle's storage, read in place by index as Vec3::operator[] reads three).
     const float* c9 = reinterpret_cast<const float*>(&tri);
@@ -95,7 +96,7 @@ struct WatertightRay {
 // preferred by the hit rule (ray.hpp). Returns whether `best` changed. `prim` is the triangle's index,
 // or a callable returning it (read only when the hit is a candidate, for structures that keep it apart).
 template <class Prim>
-inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, Prim&& prim, Hit& best) {
+CELLRT_HD inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, Prim&& prim, Hit& best) {
     float t, u, v;
     if (!intersect_unbounded(r, tri, t, u, v)) return false;
     if (!(t >= tnear) || !(t <= best.t)) return false;
@@ -108,7 +109,7 @@ inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangl
 }
 
 // Any-hit step: whether the triangle is hit at tnear <= t <= tfar.
-inline bool intersect_any(const WatertightRay& r, float tnear, float tfar, const Triangle& tri) {
+CELLRT_HD inline bool intersect_any(const WatertightRay& r, float tnear, float tfar, const Triangle& tri) {
     float t, u, v;
     return intersect_unbounded(r, tri, t, u, v) && t >= tnear && t <= tfar;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <functional>
 
+#include "accel/cuda_registry.hpp"
 #include "accel/local_store_registry.hpp"
 #include "accel/packet_table.hpp"
 #include "accel/routed_accelerator.hpp"
@@ -34,6 +35,7 @@ struct Entry {
     const ParamTable* params;
     std::vector<std::string> traversals;
     LocalStoreFactory local_store = nullptr;  // trees only
+    detail::DeviceFactory device = nullptr;   // trees only, where CUDA was found
 };
 
 std::vector<Entry> make_entries() {
@@ -54,6 +56,11 @@ std::vector<Entry> make_entries() {
     entries.push_back({"auto", &detail::make_routed, &detail::routed_params(), detail::routed_traversals()});
 #ifdef CELLRT_HAVE_EMBREE
     entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
+#endif
+#ifdef CELLRT_HAVE_CUDA
+    for (const detail::DeviceEntry& d : detail::cuda_factories())
+        for (Entry& e : entries)
+            if (e.kind == d.kind) e.device = d.make;
 #endif
     return entries;
 }
@@ -84,9 +91,29 @@ const std::vector<std::string>& accelerator_traversals(const std::string& kind) 
 // Non-finite vertices are refused here (and in make_local_store_accelerator), once for every kind and
 // before any build meets them.
 std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangles, const AccelConfig& config) {
+    if (config.device == "cuda") return make_device_accelerator(triangles, config);
+    if (config.device != "cpu") throw Error("device '" + config.device + "' is not one of: cpu, cuda");
     const Entry& e = entry(config.kind);
     check_finite(triangles);
     return e.make(triangles, config);
+}
+
+std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Triangle> triangles,
+                                                           const AccelConfig& config) {
+    const Entry& e = entry(config.kind);
+#ifndef CELLRT_HAVE_CUDA
+    throw Error("device 'cuda': " + cuda_device_info().reason);
+#endif
+    if (!e.device) {
+        std::vector<std::string> trees;
+        for (const Entry& t : entries())
+            if (t.device) trees.push_back(t.kind);
+        throw Error("the CUDA backend runs the trees (" + detail::join_names(trees) + "), not '" + config.kind + "'");
+    }
+    if (config.simd != "off")
+        throw Error("the CUDA backend runs the single-ray kernels, not SIMD packets (simd '" + config.simd + "')");
+    check_finite(triangles);
+    return e.device(triangles, config);
 }
 
 std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<const Triangle> triangles,

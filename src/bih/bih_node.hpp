@@ -9,6 +9,8 @@
 #include <bit>
 #include <cstdint>
 
+#include "cellrt/host_device.hpp"
+
 namespace cellrt::detail {
 
 class BihNode {
@@ -23,13 +25,13 @@ public:
         return BihNode(kLeafTag | (first << 2), std::bit_cast<float>(count), 0.f);
     }
 
-    bool is_leaf() const { return (word_ & 3u) == kLeafTag; }
-    int axis() const { return static_cast<int>(word_ & 3u); }
+    CELLRT_HD bool is_leaf() const { return (word_ & 3u) == kLeafTag; }
+    CELLRT_HD int axis() const { return static_cast<int>(word_ & 3u); }
     // clip(0): the left child's upper bound, clip(1): the right child's lower bound on axis().
-    float clip(std::uint32_t side) const { return clip_[side]; }
-    std::uint32_t children() const { return word_ >> 2; }
-    std::uint32_t first() const { return word_ >> 2; }
-    std::uint32_t count() const { return std::bit_cast<std::uint32_t>(clip_[0]); }
+    CELLRT_HD float clip(std::uint32_t side) const { return clip_[side]; }
+    CELLRT_HD std::uint32_t children() const { return word_ >> 2; }
+    CELLRT_HD std::uint32_t first() const { return word_ >> 2; }
+    CELLRT_HD std::uint32_t count() const { return std::bit_cast<std::uint32_t>(clip_[0]); }
     BihNode with_index(std::uint32_t i) const { return BihNode((word_ & 3u) | (i << 2), clip_[0], clip_[1]); }
 
     BihNode() = default;

@@ -22,9 +22,9 @@ struct BihTraits {
     static constexpr bool kGaps = true;
     static constexpr std::uint32_t kSentinel = 1;  // the empty padding leaf after the root (bih_tree.hpp)
     static constexpr bool kLeafEntriesIndexTriangles = false;
-    static float plane(const BihNode& n, std::uint32_t side) { return n.clip(side); }
+    CELLRT_HD static float plane(const BihNode& n, std::uint32_t side) { return n.clip(side); }
     template <class Memory>
-    static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
+    CELLRT_HD static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
         return {mem.triangle(k), mem.index(k)};
     }
 
@@ -32,7 +32,7 @@ struct BihTraits {
     // candidate hit.
     struct Leaves {
         template <class Memory, class Query, class Counters>
-        bool test(const BihNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+        CELLRT_HD bool test(const BihNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
             c.leaf();
             const std::uint32_t end = leaf.first() + leaf.count();
             for (std::uint32_t k = leaf.first(); k < end; ++k) {
@@ -46,16 +46,11 @@ struct BihTraits {
 
 enum class BihTraversal { branched, branchless };
 
+// Calls fn(kernel) with the kernel of `t`, kernel(tree, memory, ray, query, counters).
 template <class Fn>
 decltype(auto) with_bih_kernel(BihTraversal t, Fn&& fn) {
-    auto branched = [](const BihTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branched<BihTraits>(tree, mem, r, q, c);
-    };
-    auto branchless = [](const BihTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branchless<BihTraits>(tree, mem, r, q, c);
-    };
-    if (t == BihTraversal::branched) return fn(branched);
-    return fn(branchless);
+    if (t == BihTraversal::branched) return fn(BranchedKernel<BihTraits>{});
+    return fn(BranchlessKernel<BihTraits>{});
 }
 
 }  // namespace cellrt::detail

@@ -9,6 +9,8 @@
 #include <bit>
 #include <cstdint>
 
+#include "cellrt/host_device.hpp"
+
 namespace cellrt::detail {
 
 class KdNode {
@@ -21,12 +23,12 @@ public:
     }
     static KdNode leaf(std::uint32_t first, std::uint32_t count) { return KdNode(count, kLeafTag | (first << 2)); }
 
-    bool is_leaf() const { return (word_ & 3u) == kLeafTag; }
-    int axis() const { return static_cast<int>(word_ & 3u); }
-    float split() const { return std::bit_cast<float>(payload_); }
-    std::uint32_t children() const { return word_ >> 2; }  // left child; the right one follows it
-    std::uint32_t first() const { return word_ >> 2; }
-    std::uint32_t count() const { return payload_; }
+    CELLRT_HD bool is_leaf() const { return (word_ & 3u) == kLeafTag; }
+    CELLRT_HD int axis() const { return static_cast<int>(word_ & 3u); }
+    CELLRT_HD float split() const { return std::bit_cast<float>(payload_); }
+    CELLRT_HD std::uint32_t children() const { return word_ >> 2; }  // left child; the right one follows it
+    CELLRT_HD std::uint32_t first() const { return word_ >> 2; }
+    CELLRT_HD std::uint32_t count() const { return payload_; }
     // The same node with its child pair (inner) or first entry (leaf) moved to `i`.
     KdNode with_index(std::uint32_t i) const { return KdNode(payload_, (word_ & 3u) | (i << 2)); }
 

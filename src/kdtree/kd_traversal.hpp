@@ -23,7 +23,7 @@ struct RecentTriangles {
     unsigned next = 0;
 
     // True when `prim` was tested recently; otherwise remembers it.
-    bool seen(std::uint32_t prim) {
+    CELLRT_HD bool seen(std::uint32_t prim) {
         bool found = false;
         for (int i = 0; i < kSize; ++i) found |= slot[i] == prim;
         if (!found) slot[next++ % kSize] = prim;
@@ -38,9 +38,9 @@ struct KdTraits {
     static constexpr int kMaxDepth = kKdMaxDepth;
     static constexpr bool kGaps = false;
     static constexpr bool kLeafEntriesIndexTriangles = true;
-    static float plane(const KdNode& n, std::uint32_t) { return n.split(); }
+    CELLRT_HD static float plane(const KdNode& n, std::uint32_t) { return n.split(); }
     template <class Memory>
-    static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
+    CELLRT_HD static LeafEntry leaf_entry(const Memory& mem, std::uint32_t k) {
         const std::uint32_t prim = mem.index(k);
         return {mem.triangle(prim), prim};
     }
@@ -50,7 +50,7 @@ struct KdTraits {
         RecentTriangles tested;
 
         template <class Memory, class Query, class Counters>
-        bool test(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+        CELLRT_HD bool test(const KdNode& leaf, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
             c.leaf();
             const std::uint32_t end = leaf.first() + leaf.count();
             for (std::uint32_t k = leaf.first(); k < end; ++k) {
@@ -75,13 +75,13 @@ struct KdTraits {
 // they are read, and zeroing all of them cost each ray some 300 instructions.
 struct KdRecCoords {
     float c[3];
-    KdRecCoords& operator=(const Vec3& v) {
+    CELLRT_HD KdRecCoords& operator=(const Vec3& v) {
         c[0] = v.x;
         c[1] = v.y;
         c[2] = v.z;
         return *this;
     }
-    float operator[](int axis) const { return c[axis]; }
+    CELLRT_HD float operator[](int axis) const { return c[axis]; }
 };
 
 struct KdRecPoint {
@@ -93,8 +93,8 @@ struct KdRecPoint {
 static_assert(sizeof(KdRecPoint) == 40, "the local-store model budgets TA_rec's stack at 40 bytes a point");
 inline constexpr int kKdRecStackSize = kKdMaxDepth + 3;
 
-template <class Query, class Memory, class Counters>
-bool kd_traverse_rec(const KdTree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+template <class Tree, class Query, class Memory, class Counters>
+CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
     constexpr std::uint32_t kNone = ~0u;
     using Point = KdRecPoint;
     float tmin, tmax;
@@ -163,21 +163,20 @@ namespace cellrt::detail {
 // The traversals by name, as function objects, so that callers choose one per batch, not per ray.
 enum class KdTraversal { rec, branched, branchless };
 
+struct KdRecKernel {
+    template <class Tree, class Memory, class Query, class Counters>
+    CELLRT_HD bool operator()(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) const {
+        return kd_traverse_rec(tree, mem, r, q, c);
+    }
+};
+
+// Calls fn(kernel) with the kernel of `t`, kernel(tree, memory, ray, query, counters).
 template <class Fn>
 decltype(auto) with_kd_kernel(KdTraversal t, Fn&& fn) {
-    auto rec = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return kd_traverse_rec(tree, mem, r, q, c);
-    };
-    auto branched = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branched<KdTraits>(tree, mem, r, q, c);
-    };
-    auto branchless = [](const KdTree& tree, auto& mem, const TraversalRay& r, auto& q, auto& c) {
-        return traverse_branchless<KdTraits>(tree, mem, r, q, c);
-    };
     switch (t) {
-        case KdTraversal::rec: return fn(rec);
-        case KdTraversal::branched: return fn(branched);
-        default: return fn(branchless);
+        case KdTraversal::rec: return fn(KdRecKernel{});
+        case KdTraversal::branched: return fn(BranchedKernel<KdTraits>{});
+        default: return fn(BranchlessKernel<KdTraits>{});
     }
 }
 

@@ -41,7 +41,7 @@ inline constexpr int kBranchlessStackSize = Traits::kMaxDepth + 2 + (Traits::kGa
 // SIMD packets hand a lane over to it when the lane is the last one left in a subtree). The near child
 // is visited first; the far one is pushed when the ray reaches it too.
 template <class Traits, class Query, class Memory, class Counters>
-bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
+CELLRT_HD bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counters& c, std::uint32_t index,
                             float tmin, float tmax) {
     typename Traits::Leaves leaves;
     StackEntry stack[kBranchedStackSize<Traits>];
@@ -77,7 +77,7 @@ bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query& q, Counte
 }
 
 template <class Traits, class Tree, class Query, class Memory, class Counters>
-bool traverse_branched(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+CELLRT_HD bool traverse_branched(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
     float tmin, tmax;
     return r.clip(tree.bounds, tmin, tmax) && traverse_branched_from<Traits>(mem, r, q, c, 0, tmin, tmax);
 }
@@ -88,7 +88,7 @@ bool traverse_branched(const Tree& tree, Memory& mem, const TraversalRay& r, Que
 // neither and pops the entry below, so the stack's bottom is a sentinel entry naming an empty leaf,
 // which ends the traversal.
 template <class Traits, class Tree, class Query, class Memory, class Counters>
-bool traverse_branchless(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+CELLRT_HD bool traverse_branchless(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     typename Traits::Leaves leaves;
@@ -124,5 +124,23 @@ bool traverse_branchless(const Tree& tree, Memory& mem, const TraversalRay& r, Q
         if (!pop_live(stack, sp, bottom, q, index, tmin, tmax)) return false;
     }
 }
+
+// The two kernels as function objects, kernel(tree, memory, ray, query, counters): what a descriptor's
+// with_kernel() hands its caller, so that the host and a device (src/cuda/) instantiate the same ones.
+template <class Traits>
+struct BranchedKernel {
+    template <class Tree, class Memory, class Query, class Counters>
+    CELLRT_HD bool operator()(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) const {
+        return traverse_branched<Traits>(tree, mem, r, q, c);
+    }
+};
+
+template <class Traits>
+struct BranchlessKernel {
+    template <class Tree, class Memory, class Query, class Counters>
+    CELLRT_HD bool operator()(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) const {
+        return traverse_branchless<Traits>(tree, mem, r, q, c);
+    }
+};
 
 }  // namespace cellrt::detail

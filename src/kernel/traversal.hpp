@@ -17,6 +17,7 @@
 
 #include "cellrt/accelerator.hpp"
 #include "cellrt/box.hpp"
+#include "cellrt/host_device.hpp"
 #include "cellrt/ray.hpp"
 #include "cellrt/triangle.hpp"
 
@@ -28,8 +29,8 @@ inline constexpr float kMarginScale = 1.f / 65536.f;
 
 // min/max that keep the first operand when the second is NaN (a ray lying exactly in a plane gives
 // 0 * inf = NaN for the plane's distance, and then the plane must not cut the interval).
-inline float min_keep(float kept, float x) { return x < kept ? x : kept; }
-inline float max_keep(float kept, float x) { return x > kept ? x : kept; }
+CELLRT_HD inline float min_keep(float kept, float x) { return x < kept ? x : kept; }
+CELLRT_HD inline float max_keep(float kept, float x) { return x > kept ? x : kept; }
 
 struct TraversalRay {
     Vec3 org, dir, inv_dir;
@@ -39,7 +40,7 @@ struct TraversalRay {
     WatertightRay watertight;
 
     // Always inlined, with clip() and the triangle test (triangle.hpp): see intersect_unbounded.
-    [[gnu::always_inline]] TraversalRay(const Ray& r, const Box3& scene_box)
+    [[gnu::always_inline]] CELLRT_HD TraversalRay(const Ray& r, const Box3& scene_box)
         : org(r.org), dir(r.dir), tnear(r.tnear), tfar(r.tfar), watertight(r) {
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.f / dir[a];
@@ -49,12 +50,12 @@ struct TraversalRay {
         margin = kMarginScale * length(reach) / length(dir);
     }
 
-    Vec3 at(float t) const { return org + dir * t; }
+    CELLRT_HD Vec3 at(float t) const { return org + dir * t; }
 
     // The ray's interval [tnear, tfar] clipped to `box`, both widened by the margin. False when empty.
     // A slab the ray lies in exactly (origin on its face, zero direction on its axis) gives NaN and
     // does not cut the interval.
-    [[gnu::always_inline]] bool clip(const Box3& box, float& tmin, float& tmax) const {
+    [[gnu::always_inline]] CELLRT_HD bool clip(const Box3& box, float& tmin, float& tmax) const {
         tmin = tnear - margin;
         tmax = tfar + margin;
         for (int a = 0; a < 3; ++a) {
@@ -70,9 +71,9 @@ struct TraversalRay {
 
 // Work counters: the kernels call these on every node, leaf and triangle; NoCounters compiles them away.
 struct NoCounters {
-    void node() {}
-    void leaf() {}
-    void triangle() {}
+    CELLRT_HD void node() {}
+    CELLRT_HD void leaf() {}
+    CELLRT_HD void triangle() {}
 };
 
 struct WorkCounters {
@@ -89,17 +90,17 @@ struct ClosestHit {
     float tnear;
     float margin;
 
-    explicit ClosestHit(const TraversalRay& r) : best{r.tfar, kNoHit, 0.f, 0.f}, tnear(r.tnear), margin(r.margin) {}
+    CELLRT_HD explicit ClosestHit(const TraversalRay& r) : best{r.tfar, kNoHit, 0.f, 0.f}, tnear(r.tnear), margin(r.margin) {}
 
-    float cull_t() const { return best.t + margin; }
+    CELLRT_HD float cull_t() const { return best.t + margin; }
     // Tests one triangle; `prim` gives its index in the scene (read only for a candidate). Returns
     // false: a closest-hit query never ends early.
     template <class Prim>
-    bool test(const WatertightRay& r, const Triangle& tri, Prim&& prim) {
+    CELLRT_HD bool test(const WatertightRay& r, const Triangle& tri, Prim&& prim) {
         intersect_closest(r, tnear, tri, prim, best);
         return false;
     }
-    Hit result() const { return best.is_hit() ? best : Hit{}; }
+    CELLRT_HD Hit result() const { return best.is_hit() ? best : Hit{}; }
 };
 
 // Any hit: the first triangle with tnear <= t <= tfar ends the query.
@@ -108,11 +109,11 @@ struct AnyHit {
     float tnear, tfar;
     float cull;
 
-    explicit AnyHit(const TraversalRay& r) : tnear(r.tnear), tfar(r.tfar), cull(r.tfar + r.margin) {}
+    CELLRT_HD explicit AnyHit(const TraversalRay& r) : tnear(r.tnear), tfar(r.tfar), cull(r.tfar + r.margin) {}
 
-    float cull_t() const { return cull; }
+    CELLRT_HD float cull_t() const { return cull; }
     template <class Prim>
-    bool test(const WatertightRay& r, const Triangle& tri, Prim&&) {
+    CELLRT_HD bool test(const WatertightRay& r, const Triangle& tri, Prim&&) {
         return intersect_any(r, tnear, tfar, tri);
     }
 };
@@ -127,7 +128,7 @@ static_assert(sizeof(StackEntry) == 12, "a stack entry is a node index and an in
 // Pops the next stacked cell that can still hold the answer, skipping those that start past the
 // query's cull distance; false when no entry above `bottom` is left. `sp` ends on the popped slot.
 template <class Query>
-bool pop_live(const StackEntry* stack, int& sp, int bottom, const Query& q, std::uint32_t& node, float& tmin,
+CELLRT_HD bool pop_live(const StackEntry* stack, int& sp, int bottom, const Query& q, std::uint32_t& node, float& tmin,
               float& tmax) {
     do {
         if (sp == bottom) return false;
@@ -149,10 +150,10 @@ struct DirectMemory {
     const std::uint32_t* indices;
     const Triangle* triangles;
 
-    const Node& node(std::uint32_t i) const { return nodes[i]; }
-    void touch_node(std::uint32_t) const {}
-    std::uint32_t index(std::uint32_t i) const { return indices[i]; }
-    const Triangle& triangle(std::uint32_t i) const { return triangles[i]; }
+    CELLRT_HD const Node& node(std::uint32_t i) const { return nodes[i]; }
+    CELLRT_HD void touch_node(std::uint32_t) const {}
+    CELLRT_HD std::uint32_t index(std::uint32_t i) const { return indices[i]; }
+    CELLRT_HD const Triangle& triangle(std::uint32_t i) const { return triangles[i]; }
 };
 
 // A triangle of a leaf and its index in the scene: what the traits' leaf_entry() returns.
@@ -172,7 +173,7 @@ struct TreeView {
     const Triangle* triangles;
     Box3 bounds;
 
-    DirectMemory<Node> memory() const { return {nodes, entries, triangles}; }
+    CELLRT_HD DirectMemory<Node> memory() const { return {nodes, entries, triangles}; }
 };
 
 // Runs `fn(counters)` with WorkCounters adding to `*sum`, or with NoCounters when `sum` is null: the
@@ -189,20 +190,32 @@ void with_counters(TraversalCounters* sum, std::size_t rays, Fn&& fn) {
     }
 }
 
-// The batch loops behind Accelerator::intersect/occluded: `kernel(ray, query, counters)` for every
-// valid ray. Invalid rays (ray.hpp) hit nothing.
+// One ray's query, `kernel(ray, query, counters)`: what the batch loops below run for each ray on the
+// host and what each thread of the CUDA backend runs on the device (src/cuda/). An invalid ray
+// (ray.hpp) hits nothing.
+template <class Kernel, class Counters>
+CELLRT_HD Hit closest_hit(const Box3& scene_box, const Ray& ray, Counters& count, Kernel&& kernel) {
+    if (!is_valid(ray)) return Hit{};
+    const TraversalRay r(ray, scene_box);
+    ClosestHit q(r);
+    kernel(r, q, count);
+    return q.result();
+}
+
+template <class Kernel, class Counters>
+CELLRT_HD bool any_hit(const Box3& scene_box, const Ray& ray, Counters& count, Kernel&& kernel) {
+    if (!is_valid(ray)) return false;
+    const TraversalRay r(ray, scene_box);
+    AnyHit q(r);
+    return kernel(r, q, count);
+}
+
+// The batch loops behind Accelerator::intersect/occluded.
 template <class Kernel>
 void closest_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters,
                   Kernel&& kernel) {
     with_counters(counters, rays.size(), [&](auto& count) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            hits[i] = Hit{};
-            if (!is_valid(rays[i])) continue;
-            const TraversalRay r(rays[i], scene_box);
-            ClosestHit q(r);
-            kernel(r, q, count);
-            hits[i] = q.result();
-        }
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(scene_box, rays[i], count, kernel);
     });
 }
 
@@ -210,13 +223,7 @@ template <class Kernel>
 void any_hits(const Box3& scene_box, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
               TraversalCounters* counters, Kernel&& kernel) {
     with_counters(counters, rays.size(), [&](auto& count) {
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            occluded[i] = 0;
-            if (!is_valid(rays[i])) continue;
-            const TraversalRay r(rays[i], scene_box);
-            AnyHit q(r);
-            occluded[i] = kernel(r, q, count) ? 1 : 0;
-        }
+        for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = any_hit(scene_box, rays[i], count, kernel) ? 1 : 0;
     });
 }
 

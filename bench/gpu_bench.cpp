@@ -1,0 +1,197 @@
+// The CUDA backend against Embree on all of the host's cores, on the same rays (docs/GPU.md): a
+// frame's primary rays and the rays its shading casts (shadow, AO, diffuse bounce; workload.hpp) at
+// --size, for every device configuration; rays resident on the device (the kernel's own time, CUDA
+// events) and, separately, host batches with their copies in and out. Every answer is compared with
+// the host's exact one. Without a device it says so in one line and exits with status 3.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "bench_common.hpp"
+#include "cellrt/accel.hpp"
+#include "cellrt/device.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
+#include "cellrt/scene.hpp"
+#include "cellrt/timer.hpp"
+#include "cellrt/workload.hpp"
+
+namespace {
+
+using namespace cellrt;
+using bench::median;
+
+struct Options {
+    std::string scenes_dir = "../shared/scenes";
+    std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "builtin:city"};
+    std::vector<std::string> rays{"frame", "ao", "diffuse"};
+    std::vector<std::string> configs{"kd:branched", "kd:branchless", "kd:rec", "bih:branched", "bih:branchless",
+                                     "bih:branched@split=sah"};
+    std::string cpu_config = "embree";
+    std::string size = "1920x1080", json_path;
+    int repeats = 5, ao_samples = 4;
+    unsigned threads = 0;
+};
+
+struct Answers {
+    std::vector<Hit> hits;
+    std::vector<std::uint8_t> occluded;
+};
+
+// `rays` answered by `accel` on `threads` host threads, each a contiguous share in batches of 256.
+double trace_host(const Accelerator& accel, std::span<const Ray> rays, bool closest, unsigned threads, Answers& out) {
+    out.hits.resize(closest ? rays.size() : 0);
+    out.occluded.resize(closest ? 0 : rays.size());
+    const std::size_t share = (rays.size() + threads - 1) / threads;
+    Timer timer;
+    std::vector<std::thread> team;
+    for (unsigned t = 0; t < threads; ++t)
+        team.emplace_back([&, t] {
+            const std::size_t end = std::min(rays.size(), (t + 1) * share);
+            for (std::size_t i = t * share; i < end; i += 256) {
+                const std::size_t n = std::min<std::size_t>(256, end - i);
+                if (closest) accel.intersect(rays.subspan(i, n), std::span(out.hits).subspan(i, n));
+                else accel.occluded(rays.subspan(i, n), std::span(out.occluded).subspan(i, n));
+            }
+        });
+    for (std::thread& t : team) t.join();
+    return timer.seconds();
+}
+
+std::size_t differing(const Answers& a, const Answers& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < a.hits.size(); ++i) n += !(a.hits[i] == b.hits[i]);
+    for (std::size_t i = 0; i < a.occluded.size(); ++i) n += a.occluded[i] != b.occluded[i];
+    return n;
+}
+
+struct Set {
+    const char* name;
+    std::span<const Ray> rays;
+    bool closest;
+    Answers exact;
+};
+
+void bench_rays(const Scene& scene, const std::string& kind, const Options& o, const DeviceInfo& gpu,
+                nlohmann::json& out) {
+    const auto [w, h] = parse_image_size("--size", o.size);
+    const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+    AccelConfig exact_config = parse_accel_config("kd+auto");
+    const auto exact = make_accelerator(scene.triangles, exact_config);
+    ShadingOptions shading;
+    shading.shading = kind == "frame" ? Shading::direct : parse_shading(kind);
+    shading.ao_samples = o.ao_samples;
+    const FrameRays f = frame_rays(scene, w, h, 16, *exact, shading);
+    Set sets[2] = {{"primary", f.primary, true, {}}, {to_string(f.secondary_kind), f.secondary, closest_hit(f.secondary_kind), {}}};
+    for (Set& s : sets) trace_host(*exact, s.rays, s.closest, threads, s.exact);
+    std::printf("\n### %s, %s rays, %dx%d: %zu primary + %zu %s\n\n| config | primary Grays/s | %s Grays/s | "
+                "with copies Grays/s | answers ≠ exact |\n|---|---|---|---|---|\n",
+                scene.name.c_str(), kind.c_str(), w, h, f.primary.size(), f.secondary.size(), sets[1].name,
+                sets[1].name);
+    nlohmann::json row = {{"scene", scene.name}, {"rays", kind}, {"width", w}, {"height", h},
+                          {"primary_rays", f.primary.size()}, {"secondary_rays", f.secondary.size()},
+                          {"secondary_kind", sets[1].name}, {"device", gpu.name}, {"host_threads", threads}};
+    // Embree (or --cpu-config) on every host core, the same rays.
+    if (bench::built_in(parse_accel_config(o.cpu_config).kind)) {
+        const auto cpu = make_accelerator(scene.triangles, parse_accel_config(o.cpu_config));
+        for (Set& s : sets) {
+            std::vector<double> t;
+            Answers a;
+            for (int k = 0; k < o.repeats; ++k) t.push_back(trace_host(*cpu, s.rays, s.closest, threads, a));
+            row["cpu"][s.name] = {{"config", o.cpu_config}, {"seconds", median(t)},
+                                  {"grays_per_s", s.rays.size() / median(t) * 1e-9}, {"differing", differing(a, s.exact)}};
+        }
+    }
+    for (const std::string& spec : o.configs) {
+        AccelConfig c = parse_accel_config(spec);
+        const auto gpu_accel = make_device_accelerator(scene.triangles, c);
+        nlohmann::json r = {{"config", spec}};
+        for (Set& s : sets) {
+            DeviceRayBatch batch(s.rays.size());
+            batch.upload(s.rays);
+            std::vector<double> kernel, copies;
+            Answers a;
+            for (int k = 0; k <= o.repeats; ++k) {  // the first pass warms up
+                const double t = s.closest ? gpu_accel->intersect_resident(batch) : gpu_accel->occluded_resident(batch);
+                if (k > 0) kernel.push_back(t);
+            }
+            for (int k = 0; k < o.repeats; ++k) {
+                Timer timer;
+                if (s.closest) {
+                    a.hits.resize(s.rays.size());
+                    gpu_accel->intersect(s.rays, a.hits);
+                } else {
+                    a.occluded.resize(s.rays.size());
+                    gpu_accel->occluded(s.rays, a.occluded);
+                }
+                copies.push_back(timer.seconds());
+            }
+            Answers resident;
+            if (s.closest) {
+                resident.hits.resize(s.rays.size());
+                batch.download_hits(resident.hits);
+            } else {
+                resident.occluded.resize(s.rays.size());
+                batch.download_occluded(resident.occluded);
+            }
+            r[s.name] = {{"kernel_seconds", median(kernel)}, {"grays_per_s", s.rays.size() / median(kernel) * 1e-9},
+                         {"with_copies_seconds", median(copies)},
+                         {"with_copies_grays_per_s", s.rays.size() / median(copies) * 1e-9},
+                         {"differing", differing(a, s.exact) + differing(resident, s.exact)}};
+            if (row.contains("cpu")) r[s.name]["times_cpu"] = row["cpu"][s.name]["seconds"].get<double>() / median(kernel);
+        }
+        std::printf("| %s | %.3f | %.3f | %.3f / %.3f | %zu |\n", spec.c_str(), r["primary"]["grays_per_s"].get<double>(),
+                    r[sets[1].name]["grays_per_s"].get<double>(), r["primary"]["with_copies_grays_per_s"].get<double>(),
+                    r[sets[1].name]["with_copies_grays_per_s"].get<double>(),
+                    r["primary"]["differing"].get<std::size_t>() + r[sets[1].name]["differing"].get<std::size_t>());
+        row["gpu"].push_back(r);
+    }
+    out.push_back(row);
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options o;
+    CLI::App app{"cellrt's CUDA backend against Embree on the host's cores, the same rays"};
+    app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
+    app.add_option("--scenes", o.scenes, "Shared scene names or builtin:... specs")->capture_default_str();
+    app.add_option("--rays", o.rays, "Ray sets: frame (shadow), ao, diffuse")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"frame", "ao", "diffuse"}));
+    app.add_option("--configs", o.configs, "Device configurations KIND[:TRAVERSAL][@NAME=VALUE,...]")->capture_default_str();
+    app.add_option("--cpu-config", o.cpu_config, "The host's yardstick, on every core")->capture_default_str();
+    app.add_option("--size", o.size, "Frame size WxH")->capture_default_str();
+    app.add_option("--ao-samples", o.ao_samples, "AO rays per hit")->capture_default_str()->check(CLI::Range(1, kMaxAoSamples));
+    app.add_option("--repeats", o.repeats, "Timed passes (median)")->capture_default_str()->check(CLI::Range(1, 1000));
+    app.add_option("--threads", o.threads, "Host threads for the yardstick (0: all)")->capture_default_str();
+    app.add_option("--json", o.json_path, "Write every result as JSON");
+    CLI11_PARSE(app, argc, argv);
+    const DeviceInfo gpu = cuda_device_info();
+    if (!gpu.present) {
+        std::printf("cuda: no device (%s)\n", gpu.reason.c_str());
+        return 3;
+    }
+    nlohmann::json out = nlohmann::json::array();
+    try {
+        for (const std::string& name : o.scenes)
+            if (const auto spec = bench::scene_spec(o.scenes_dir, name)) {
+                const Scene scene = load_scene(*spec);
+                for (const std::string& kind : o.rays) {
+                    bench_rays(scene, kind, o, gpu, out);
+                    // Rewritten after every set, so that a run cut short keeps what it measured.
+                    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
+                }
+            }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "cellrt_gpu_bench: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

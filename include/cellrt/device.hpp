@@ -1,0 +1,69 @@
+// The GPU side of the accelerator boundary (docs/GPU.md): what a CUDA device is present, batches of
+// rays that stay in its memory between calls, and the accelerator that traces them there. A device
+// accelerator is also an ordinary Accelerator: intersect()/occluded() over host batches copy the rays
+// in, trace them on the device and copy the answers out, with the hits of every other path (the hit
+// rule of ray.hpp; the device runs the host's own kernel source). make_device_accelerator
+// (cellrt/accel.hpp) builds one.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "cellrt/accelerator.hpp"
+#include "cellrt/ray.hpp"
+
+namespace cellrt {
+
+// The CUDA device this process would use (device 0), or why there is none. Never throws.
+struct DeviceInfo {
+    bool present = false;
+    std::string name;             // e.g. "NVIDIA H200"
+    int compute_major = 0, compute_minor = 0;
+    int multiprocessors = 0;
+    std::size_t memory_bytes = 0;
+    std::size_t shared_memory_per_block = 0;  // the opt-in maximum, bytes
+    std::string reason;           // when !present: no CUDA in this build, no driver, no device, ...
+};
+DeviceInfo cuda_device_info();
+
+// A batch of rays and their answers resident in device memory (Aila & Laine's measurements keep rays
+// on the device: a frame's rays are made and consumed there). Not copyable; one thread at a time.
+class DeviceRayBatch {
+public:
+    // Room for `capacity` rays. Throws cellrt::Error when CUDA is absent or the allocation fails.
+    explicit DeviceRayBatch(std::size_t capacity);
+    ~DeviceRayBatch();
+    DeviceRayBatch(const DeviceRayBatch&) = delete;
+    DeviceRayBatch& operator=(const DeviceRayBatch&) = delete;
+
+    // Copies `rays` in; size() becomes rays.size(). Throws cellrt::Error when it exceeds capacity().
+    void upload(std::span<const Ray> rays);
+    // Copy the answers of the last intersect/occluded out; spans of size() elements.
+    void download_hits(std::span<Hit> hits) const;
+    void download_occluded(std::span<std::uint8_t> occluded) const;
+
+    std::size_t size() const { return size_; }
+    std::size_t capacity() const { return capacity_; }
+    // Device pointers, for a caller's own kernels (a frame made on the device).
+    const Ray* device_rays() const { return rays_; }
+    Hit* device_hits() const { return hits_; }
+    std::uint8_t* device_occluded() const { return occluded_; }
+
+private:
+    std::size_t size_ = 0, capacity_ = 0;
+    Ray* rays_ = nullptr;
+    Hit* hits_ = nullptr;
+    std::uint8_t* occluded_ = nullptr;
+};
+
+class DeviceAccelerator : public Accelerator {
+public:
+    // Trace a resident batch in place; return the kernel's own time in seconds (CUDA events: no
+    // transfer, no launch set-up on the host). Counters as for intersect().
+    virtual double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
+    virtual double occluded_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
+};
+
+}  // namespace cellrt

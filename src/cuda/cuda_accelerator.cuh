@@ -1,0 +1,112 @@
+// A tree on the GPU behind the accelerator boundary: built on the host by its descriptor `S` (the same
+// tree the CPU paths trace), packed (device_tree.hpp) and copied to the device once; traced there by
+// the descriptor's own kernels, one ray per thread (trace_kernels.cuh). Host batches are copied in and
+// out in the calling thread's own stream, so calls from many threads run at once, as the boundary
+// requires (accelerator.hpp).
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <string>
+#include <vector>
+
+#include "cellrt/device.hpp"
+#include "cellrt/timer.hpp"
+#include "cuda/cuda_check.cuh"
+#include "cuda/trace_kernels.cuh"
+#include "kernel/named.hpp"
+#include "kernel/param_reader.hpp"
+
+namespace cellrt::detail {
+
+template <class S>
+class CudaAccelerator final : public DeviceAccelerator {
+public:
+    CudaAccelerator(std::span<const Triangle> triangles, const AccelConfig& config)
+        : traversal_name_(choose_traversal(names_of(S::kTraversals), config.traversal, S::kName)),
+          traversal_(value_named(S::kTraversals, traversal_name_, "traversal")),
+          device_(require_cuda_device()) {
+        Timer timer;
+        const S s(triangles, config);
+        stats_.build_seconds = timer.seconds();
+        stats_.name = S::kName;
+        stats_.traversal = traversal_name_;
+        stats_.memory_bytes = s.memory_bytes();
+        stats_.triangles = s.triangle_array().size();
+        stats_.tree = s.report();
+        stats_.settings = s.settings();
+        stats_.settings.push_back({"device", "cuda: " + device_.name});
+        layout_ = packed_layout<typename S::Traits>(s.nodes().size(), s.entries().size(), s.triangle_array().size(),
+                                                   s.bounds());
+        std::vector<std::byte> host(layout_.bytes);
+        pack_tree<typename S::Traits>(s.nodes(), s.entries(), s.triangle_array(), layout_, host.data());
+        cuda_check(cudaMalloc(&tree_, layout_.bytes), "cudaMalloc (tree)");
+        if (const cudaError_t e = cudaMemcpy(tree_, host.data(), layout_.bytes, cudaMemcpyHostToDevice); e != cudaSuccess) {
+            cudaFree(tree_);
+            cuda_check(e, "cudaMemcpy (tree)");
+        }
+    }
+    ~CudaAccelerator() override { cudaFree(tree_); }
+    CudaAccelerator(const CudaAccelerator&) = delete;
+    CudaAccelerator& operator=(const CudaAccelerator&) = delete;
+
+    AccelStats stats() const override { return stats_; }
+
+    double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters) const override {
+        StreamTimer timer(cudaStreamPerThread);
+        launch<false>(batch.device_rays(), batch.device_hits(), nullptr, batch.size(), cudaStreamPerThread, counters);
+        return timer.seconds();
+    }
+    double occluded_resident(DeviceRayBatch& batch, TraversalCounters* counters) const override {
+        StreamTimer timer(cudaStreamPerThread);
+        launch<true>(batch.device_rays(), nullptr, batch.device_occluded(), batch.size(), cudaStreamPerThread,
+                     counters);
+        return timer.seconds();
+    }
+
+private:
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        host_batch<false>(rays, hits.data(), hits.size_bytes(), counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        host_batch<true>(rays, occluded.data(), occluded.size_bytes(), counters);
+    }
+
+    // Rays in, kernel, answers out, in this thread's stream; returns when the answers are in `out`.
+    template <bool kAny>
+    void host_batch(std::span<const Ray> rays, void* out, std::size_t out_bytes, TraversalCounters* counters) const {
+        if (rays.empty()) return;
+        const cudaStream_t stream = cudaStreamPerThread;
+        const std::size_t out_offset = align_up(rays.size_bytes(), kPackedAlignment);
+        StreamBuffer buffer(out_offset + out_bytes, stream);
+        cuda_check(cudaMemcpyAsync(buffer.at<Ray>(0), rays.data(), rays.size_bytes(), cudaMemcpyHostToDevice, stream),
+                   "cudaMemcpyAsync (rays)");
+        launch<kAny>(buffer.at<Ray>(0), buffer.at<Hit>(out_offset), buffer.at<std::uint8_t>(out_offset), rays.size(),
+                     stream, counters);
+        cuda_check(cudaMemcpyAsync(out, buffer.at<char>(out_offset), out_bytes, cudaMemcpyDeviceToHost, stream),
+                   "cudaMemcpyAsync (answers)");
+        cuda_check(cudaStreamSynchronize(stream), "kernel");
+    }
+
+    template <bool kAny>
+    void launch(const Ray* rays, Hit* hits, std::uint8_t* occluded, std::size_t n, cudaStream_t stream,
+                TraversalCounters* counters) const {
+        // The warps' fetch counter runs up to n plus 32 a warp, in 32 bits.
+        if (n > (std::size_t{1} << 31)) throw Error("a device batch holds at most 2^31 rays");
+        S::with_kernel(traversal_, [&](auto kernel) {
+            launch_trace<typename S::Traits, decltype(kernel), kAny>(
+                static_cast<const std::byte*>(tree_), layout_, rays, hits, occluded, static_cast<std::uint32_t>(n),
+                device_.multiprocessors, stream, counters);
+        });
+    }
+
+    std::string traversal_name_;
+    typename S::Traversal traversal_;
+    DeviceInfo device_;
+    AccelStats stats_;
+    PackedTree layout_;
+    void* tree_ = nullptr;
+};
+
+}  // namespace cellrt::detail

@@ -1,0 +1,191 @@
+// The CUDA backend on a GPU: every tree and traversal returns exactly the brute-force hits through
+// host batches and resident batches, counts the host's work, and `render --device cuda` writes the
+// CPU's image. These tests need a device and show as SKIPPED without one (CI has none; docs/GPU.md);
+// what the backend says without a device, or without CUDA in the build, is tested everywhere.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <sys/wait.h>
+
+#include "cellrt/accel.hpp"
+#include "cellrt/device.hpp"
+#include "cellrt/error.hpp"
+#include "cellrt/image.hpp"
+#include "error_of.hpp"
+#include "ray_suite.hpp"
+#include "structure_cases.hpp"
+
+namespace cellrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have_gpu() { return cuda_device_info().present; }
+
+#define REQUIRE_GPU()                                                                                   \
+    do {                                                                                                \
+        if (!have_gpu()) GTEST_SKIP() << "no CUDA device: " << cuda_device_info().reason;              \
+    } while (0)
+
+// The program's output and exit status; CELLRT_CLI in the environment names the program where the
+// tests run from a bundle (tools/device-check.sh).
+std::pair<std::string, int> run_cli(const std::string& args) {
+    const char* env = std::getenv("CELLRT_CLI");
+    FILE* p = ::popen((std::string(env ? env : CELLRT_CLI) + " " + args + " 2>&1").c_str(), "r");
+    if (!p) return {"", -1};
+    std::string out;
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    const int status = ::pclose(p);
+    return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+AccelConfig cuda_config(const std::string& spec) {
+    AccelConfig c = parse_accel_config(spec);
+    c.device = "cuda";
+    return c;
+}
+
+const std::vector<std::string> kCudaConfigs = {"kd:branched", "kd:rec",          "kd:branchless",
+                                               "bih:branched", "bih:branchless", "bih:branched@split=sah"};
+
+TEST(CudaInfo, NamesTheDeviceOrSaysInOneLineThatThereIsNone) {
+    const DeviceInfo d = cuda_device_info();
+    const auto [out, status] = run_cli("info --device cuda");
+    if (d.present) {
+        EXPECT_EQ(status, 0) << out;
+        EXPECT_NE(out.find(d.name), std::string::npos) << out;
+    } else {
+        EXPECT_FALSE(d.reason.empty());
+        EXPECT_EQ(status, 3) << out;
+        EXPECT_EQ(out, "cuda: no device (" + d.reason + ")\n");
+    }
+}
+
+// Kinds, SIMD packets and devices the backend does not take are refused with a reason, device or not.
+TEST(CudaRefusals, InTheLibrarysWords) {
+    const std::vector<Triangle> tri = {{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}}};
+    AccelConfig bad_device = parse_accel_config("kd");
+    bad_device.device = "tpu";
+    EXPECT_EQ(test::error_of([&] { make_accelerator(tri, bad_device); }), "device 'tpu' is not one of: cpu, cuda");
+    for (const std::string spec : {"bvh", "brute", "kd+avx2"}) {
+        const std::string e = test::error_of([&] { make_accelerator(tri, cuda_config(spec)); });
+        EXPECT_NE(e, "no error") << spec;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << spec << ": " << e;
+    }
+    if (!have_gpu()) {
+        const std::string e = test::error_of([&] { make_accelerator(tri, cuda_config("kd")); });
+        EXPECT_EQ(e, "device 'cuda': " + cuda_device_info().reason);
+        EXPECT_NE(test::error_of([&] { DeviceRayBatch batch(16); }), "no error");
+        const fs::path image = fs::temp_directory_path() / ("cellrt_cuda_refused_" + std::to_string(::getpid()) + ".png");
+        const auto [out, status] =
+            run_cli("render builtin:spheres?tris=200 --size 8x8 --device cuda -o " + image.string());
+        EXPECT_EQ(status, 1) << out;
+        EXPECT_FALSE(fs::exists(image));
+        EXPECT_EQ(out, "cellrt: error: device 'cuda': " + cuda_device_info().reason + "\n");
+    }
+}
+
+class CudaAgainstBruteForce : public testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+TEST_P(CudaAgainstBruteForce, SameHits) {
+    REQUIRE_GPU();
+    const auto& [scene_name, spec] = GetParam();
+    const Scene* scene = test::structure_scene(scene_name);
+    if (!scene) GTEST_SKIP() << "scene " << scene_name << " not found under " << test::scenes_dir();
+    const test::ReferenceAnswers& ref = test::cached_reference(scene_name, scene->triangles);
+    test::expect_matches(*make_accelerator(scene->triangles, cuda_config(spec)), ref, "cuda " + spec + " on " + scene_name);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, CudaAgainstBruteForce,
+                         testing::Combine(testing::ValuesIn(test::structure_scene_names()), testing::ValuesIn(kCudaConfigs)),
+                         [](const auto& info) {
+                             std::string s = test::test_name(std::get<0>(info.param)) + "_" + std::get<1>(info.param);
+                             for (char& c : s)
+                                 if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                             return s;
+                         });
+
+TEST(CudaDegenerate, SameHitsAsBruteForce) {
+    REQUIRE_GPU();
+    for (const auto& [what, tris] : test::degenerate_scenes()) {
+        const test::ReferenceAnswers ref = test::reference_suite(tris, test::small_suite());
+        for (const std::string& spec : kCudaConfigs)
+            test::expect_matches(*make_accelerator(tris, cuda_config(spec)), ref, "cuda " + spec + " on " + what);
+    }
+}
+
+TEST(CudaDegenerate, EmptySceneAndEmptyBatches) {
+    REQUIRE_GPU();
+    const std::vector<Triangle> none;
+    const std::vector<Ray> rays = {{{0.f, 0.f, 0.f}, 0.f, {1.f, 0.f, 0.f}, kInfinity}};
+    for (const std::string& spec : kCudaConfigs) {
+        const auto accel = make_accelerator(none, cuda_config(spec));
+        std::vector<Hit> hits(1);
+        std::vector<std::uint8_t> occluded(1, 2);
+        accel->intersect(rays, hits);
+        accel->occluded(rays, occluded);
+        EXPECT_FALSE(hits[0].is_hit()) << spec;
+        EXPECT_EQ(occluded[0], 0) << spec;
+        accel->intersect({}, {});
+        EXPECT_THROW(accel->intersect(rays, {}), Error) << spec;
+    }
+}
+
+// Resident batches give the host batches' answers, and the device counts the host's work exactly.
+TEST(CudaResident, SameAnswersAndWorkAsTheHost) {
+    REQUIRE_GPU();
+    const Scene& scene = test::cached_scene("builtin:city?tris=20000");
+    const test::ReferenceAnswers& ref = test::cached_reference("builtin:city?tris=20000", scene.triangles);
+    for (const std::string& spec : kCudaConfigs) {
+        const auto device = make_device_accelerator(scene.triangles, cuda_config(spec));
+        DeviceRayBatch batch(ref.rays.size());
+        batch.upload(ref.rays);
+        TraversalCounters on_device, on_host;
+        EXPECT_GT(device->intersect_resident(batch, &on_device), 0.0);
+        std::vector<Hit> hits(ref.rays.size());
+        batch.download_hits(hits);
+        EXPECT_TRUE(hits == ref.hits) << spec;
+        device->occluded_resident(batch);
+        std::vector<std::uint8_t> occluded(ref.rays.size());
+        batch.download_occluded(occluded);
+        EXPECT_TRUE(occluded == ref.occluded) << spec;
+        make_accelerator(scene.triangles, parse_accel_config(spec))->intersect(ref.rays, hits, &on_host);
+        EXPECT_EQ(on_device.rays, on_host.rays) << spec;
+        EXPECT_EQ(on_device.nodes, on_host.nodes) << spec;
+        EXPECT_EQ(on_device.leaves, on_host.leaves) << spec;
+        EXPECT_EQ(on_device.triangles, on_host.triangles) << spec;
+        EXPECT_THROW(batch.upload(std::vector<Ray>(ref.rays.size() + 1)), Error);
+    }
+}
+
+// `render --device cuda` writes the CPU's image, bit for bit, under every shading.
+TEST(CudaRender, SameImageAsTheCpu) {
+    REQUIRE_GPU();
+    const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    for (const char* shading : {"direct", "ao --ao-samples 3", "diffuse"}) {
+        auto render = [&](const std::string& name, const std::string& extra) {
+            const fs::path out = dir / (name + ".pfm");
+            const auto [text, status] = run_cli("render builtin:spheres?tris=3000 --size 67x45 --overwrite --shading " +
+                                                std::string(shading) + " " + extra + " -o " + out.string());
+            EXPECT_EQ(status, 0) << text;
+            return read_pfm(out.string());
+        };
+        const Image cpu = render("cpu", "--accel kd");
+        for (const char* accel : {"kd", "bih"}) {
+            const Image gpu = render(std::string("gpu_") + accel, std::string("--device cuda --accel ") + accel);
+            ASSERT_EQ(gpu.pixels.size(), cpu.pixels.size());
+            EXPECT_EQ(std::memcmp(gpu.pixels.data(), cpu.pixels.data(), cpu.pixels.size() * sizeof(Vec3)), 0)
+                << accel << " " << shading;
+        }
+    }
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cellrt

@@ -1,0 +1,161 @@
+// The CUDA backend's device code, compiled for the host (CELLRT_HD is empty here) and held to brute
+// force bit for bit: what each GPU thread runs for one ray (cuda/device_trace.hpp), every tree of the
+// registry's list and every traversal, over the tree packed as the backend copies it to the device
+// (cuda/device_tree.hpp), on the built-in and shared scenes and the degenerate inputs. Runs with or
+// without CUDA and a GPU: CI has neither (docs/GPU.md).
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <memory>
+#include <new>
+#include <type_traits>
+
+#include "accel/structures.hpp"
+#include "cellrt/accel.hpp"
+#include "cuda/device_trace.hpp"
+#include "cuda/device_tree.hpp"
+#include "ray_suite.hpp"
+#include "structure_cases.hpp"
+
+namespace cellrt {
+namespace {
+
+// A tree packed into one 16-byte aligned buffer and traced ray by ray with the device's per-thread
+// functions, behind the accelerator boundary so that the suite's comparison applies as it is.
+template <class S, class Kernel>
+class PackedTracer final : public Accelerator {
+public:
+    using Traits = typename S::Traits;
+    explicit PackedTracer(const S& s)
+        : layout_(detail::packed_layout<Traits>(s.nodes().size(), s.entries().size(), s.triangle_array().size(),
+                                                s.bounds())),
+          bytes_(static_cast<std::byte*>(::operator new(layout_.bytes, std::align_val_t{detail::kPackedAlignment}))) {
+        detail::pack_tree<Traits>(s.nodes(), s.entries(), s.triangle_array(), layout_, bytes_.get());
+    }
+    AccelStats stats() const override { return {}; }
+
+private:
+    struct Free {
+        void operator()(std::byte* p) const { ::operator delete(p, std::align_val_t{detail::kPackedAlignment}); }
+    };
+    void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
+        const auto view = detail::packed_view<Traits>(bytes_.get(), layout_);
+        detail::RayCounters c;
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = detail::trace_closest<Traits, Kernel>(view, rays[i], c);
+        add(c, rays.size(), counters);
+    }
+    void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                     TraversalCounters* counters) const override {
+        const auto view = detail::packed_view<Traits>(bytes_.get(), layout_);
+        detail::RayCounters c;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            occluded[i] = detail::trace_any<Traits, Kernel>(view, rays[i], c) ? 1 : 0;
+        add(c, rays.size(), counters);
+    }
+    static void add(const detail::RayCounters& c, std::size_t rays, TraversalCounters* counters) {
+        if (!counters) return;
+        counters->rays += rays;
+        counters->nodes += c.nodes;
+        counters->leaves += c.leaves;
+        counters->triangles += c.triangles;
+    }
+
+    detail::PackedTree layout_;
+    std::unique_ptr<std::byte, Free> bytes_;
+};
+
+// The host's own closest-hit batch loop over a tree's own arrays, as its single-ray accelerator runs it.
+using HostPath = std::function<void(std::span<const Ray>, std::span<Hit>, TraversalCounters*)>;
+
+// Calls check(name, tracer, host) for every listed tree and traversal, the tree built over `tris` as
+// the host's single-ray path builds it.
+template <class Check>
+void for_every_device_kernel(std::span<const Triangle> tris, Check&& check) {
+    detail::TreeStructures::for_each([&]<class S>(std::type_identity<S>) {
+        AccelConfig config;
+        config.kind = S::kName;
+        const S s(tris, config);
+        for (const auto& t : S::kTraversals) {
+            S::with_kernel(t.value, [&](auto kernel) {
+                const PackedTracer<S, decltype(kernel)> tracer(s);
+                const HostPath host = [&](std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* c) {
+                    auto mem = s.view().memory();
+                    detail::closest_hits(s.bounds(), rays, hits, c, [&](const detail::TraversalRay& r, auto& q,
+                                                                         auto& count) {
+                        return kernel(s.tree, mem, r, q, count);
+                    });
+                };
+                check(std::string(S::kName) + ":" + t.name, tracer, host);
+            });
+        }
+    });
+}
+
+class DeviceCode : public testing::TestWithParam<std::string> {};
+
+// Same hits as brute force, and the same work counts as the host's own single-ray path: the device
+// runs the same kernel over the same tree.
+TEST_P(DeviceCode, SameHitsAndWorkAsTheHost) {
+    const Scene* scene = test::structure_scene(GetParam());
+    if (!scene) GTEST_SKIP() << "scene " << GetParam() << " not found under " << test::scenes_dir();
+    const test::ReferenceAnswers& ref = test::cached_reference(GetParam(), scene->triangles);
+    for_every_device_kernel(scene->triangles, [&](const std::string& name, const Accelerator& tracer,
+                                                  const HostPath& host_path) {
+        test::expect_matches(tracer, ref, "device code " + name + " on " + GetParam());
+        const std::span<const Ray> some = std::span(ref.rays).first(std::min<std::size_t>(ref.rays.size(), 20000));
+        std::vector<Hit> hits(some.size());
+        TraversalCounters device, host;
+        tracer.intersect(some, hits, &device);
+        host_path(some, hits, &host);
+        EXPECT_GT(host.triangles, 0u) << name;
+        EXPECT_EQ(device.nodes, host.nodes) << name;
+        EXPECT_EQ(device.leaves, host.leaves) << name;
+        EXPECT_EQ(device.triangles, host.triangles) << name;
+    });
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, DeviceCode, testing::ValuesIn(test::structure_scene_names()),
+                         [](const auto& info) { return test::test_name(info.param); });
+
+TEST(DeviceCodeDegenerate, SameHitsAsBruteForce) {
+    for (const auto& [what, tris] : test::degenerate_scenes()) {
+        const test::ReferenceAnswers ref = test::reference_suite(tris, test::small_suite());
+        for_every_device_kernel(tris, [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
+            test::expect_matches(tracer, ref, "device code " + name + " on " + what);
+        });
+    }
+}
+
+TEST(DeviceCodeDegenerate, EmptySceneMissesEverything) {
+    const std::vector<Triangle> none;
+    const std::vector<Ray> rays = {{{0.f, 0.f, 0.f}, 0.f, {1.f, 0.f, 0.f}, kInfinity}};
+    for_every_device_kernel(none, [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
+        std::vector<Hit> hits(1);
+        std::vector<std::uint8_t> occluded(1, 2);
+        tracer.intersect(rays, hits);
+        tracer.occluded(rays, occluded);
+        EXPECT_FALSE(hits[0].is_hit()) << name;
+        EXPECT_EQ(occluded[0], 0) << name;
+    });
+}
+
+// The packed layout: every array at a 16-byte boundary, in order, nothing overlapping.
+TEST(DevicePackedTree, ArraysAlignedAndDisjoint) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=2000");
+    detail::TreeStructures::for_each([&]<class S>(std::type_identity<S>) {
+        AccelConfig config;
+        config.kind = S::kName;
+        const S s(scene.triangles, config);
+        const auto p = detail::packed_layout<typename S::Traits>(s.nodes().size(), s.entries().size(),
+                                                                 s.triangle_array().size(), s.bounds());
+        EXPECT_EQ(p.entries_offset % detail::kPackedAlignment, 0u);
+        EXPECT_EQ(p.triangles_offset % detail::kPackedAlignment, 0u);
+        EXPECT_GE(p.entries_offset, s.nodes().size_bytes());
+        EXPECT_GE(p.triangles_offset, p.entries_offset + s.entries().size_bytes());
+        EXPECT_GE(p.bytes, p.triangles_offset + s.triangle_array().size_bytes());
+        EXPECT_LT(p.bytes, p.triangles_offset + s.triangle_array().size_bytes() + detail::kPackedAlignment);
+    });
+}
+
+}  // namespace
+}  // namespace cellrt
