@@ -52,6 +52,14 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
 void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
             RenderStats* stats = nullptr);
 
+// The pixels of `window` only, a rectangle inside the options.width x options.height frame, into
+// `tile` (reused when it already has the window's size): each pixel gets the colour render() gives
+// it, since a pixel's colour depends only on its own rays. Packets are cut from the window's top-left
+// corner; `progress` counts the window's packets. Throws cellrt::Error as render() does, and for a
+// window that is empty or not inside the frame. A distributed frame is traced this way, tile by tile.
+void render_window(const Scene& scene, const Accelerator& accel, const RenderOptions& options, const PixelRect& window,
+                   Image& tile, RenderStats* stats = nullptr);
+
 // The point a hit names and the triangle's geometric normal there, turned to face the side the ray
 // came from.
 struct SurfacePoint {

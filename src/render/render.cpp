@@ -121,9 +121,20 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
 
 void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& image,
             RenderStats* stats) {
+    render_window(scene, accel, options, PixelRect{0, 0, options.width, options.height}, image, stats);
+}
+
+void render_window(const Scene& scene, const Accelerator& accel, const RenderOptions& options, const PixelRect& window,
+                   Image& image, RenderStats* stats) {
     const PinholeCamera camera(scene.camera, options.width, options.height);
-    const PacketGrid grid(options.width, options.height, options.packet);
-    if (image.width != options.width || image.height != options.height) image = Image(options.width, options.height);
+    if (window.x0 < 0 || window.y0 < 0 || window.x1 > options.width || window.y1 > options.height ||
+        window.width() < 1 || window.height() < 1)
+        throw Error("window [" + std::to_string(window.x0) + ", " + std::to_string(window.x1) + ") x [" +
+                    std::to_string(window.y0) + ", " + std::to_string(window.y1) + ") is not inside the " +
+                    std::to_string(options.width) + "x" + std::to_string(options.height) + " frame");
+    const PacketGrid grid(window.width(), window.height(), options.packet);
+    if (image.width != window.width() || image.height != window.height())
+        image = Image(window.width(), window.height());
     ScheduleOptions schedule;
     schedule.dispatch = options.dispatch;
     schedule.workers = options.threads;
@@ -141,17 +152,19 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
 
     Timer timer;
     std::vector<WorkerLoad> loads;
+    // The grid's packets are the window's; the rays are the frame's pixels under them.
     const bool complete = run_packets(
         grid, schedule, image,
         [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
-            trace_packet(scene, accel, rect, options.count, work[w], out);
+            const PixelRect pixels{rect.x0 + window.x0, rect.y0 + window.y0, rect.x1 + window.x0, rect.y1 + window.y0};
+            trace_packet(scene, accel, pixels, options.count, work[w], out);
         },
         &loads);
     if (!complete) throw Error("render cancelled");
     if (stats) {
         *stats = RenderStats{};
         stats->seconds = timer.seconds();
-        stats->primary_rays = static_cast<std::uint64_t>(options.width) * options.height;
+        stats->primary_rays = static_cast<std::uint64_t>(window.pixels());
         stats->workers = std::move(loads);
         for (const PacketWork& w : work) {
             stats->primary += w.primary;
