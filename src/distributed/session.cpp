@@ -25,15 +25,20 @@ Session::Session(int& argc, char**& argv) {
 
 Session::~Session() { MPI_Finalize(); }
 
+std::string Session::timeout_text() const {
+    char text[48];
+    std::snprintf(text, sizeof text, "%g s", static_cast<double>(timeout_.count()) / 1e3);
+    return text;
+}
+
 void Session::wait(MPI_Request& request, const std::string& what) const {
+    const double limit = static_cast<double>(timeout_.count()) / 1e3 * (leader() ? 1.0 : 2.0);
     Timer timer;
     int done = 0;
     for (MPI_Test(&request, &done, MPI_STATUS_IGNORE); !done; MPI_Test(&request, &done, MPI_STATUS_IGNORE)) {
-        if (timer.seconds() * 1e3 > static_cast<double>(timeout_.count())) {
-            char seconds[32];
-            std::snprintf(seconds, sizeof seconds, "%g", static_cast<double>(timeout_.count()) / 1e3);
-            abort("no answer to " + what + " within " + seconds + " s (a rank stopped answering; --rank-timeout)");
-        }
+        if (timer.seconds() > limit)
+            abort("no answer to " + what + " within " + (leader() ? "" : "twice ") + timeout_text() +
+                  " (a rank stopped answering; --rank-timeout)");
         std::this_thread::sleep_for(kPollInterval);
     }
 }

@@ -47,7 +47,11 @@ public:
     std::chrono::milliseconds timeout() const { return timeout_; }
     void set_timeout(std::chrono::milliseconds t) { timeout_ = t; }
 
-    // Polls `request` until it completes. When it has not within the time-out, prints
+    // The time-out as text ("120 s").
+    std::string timeout_text() const;
+
+    // Polls `request` until it completes. When it has not within the time-out (on ranks other than 0
+    // twice the time-out, so that rank 0, which knows which rank is missing, speaks first), prints
     // "cellrt: error: rank R: no answer to WHAT within T s" and aborts the job (MPI_Abort: a rank that
     // stopped answering cannot take part in an orderly end).
     void wait(MPI_Request& request, const std::string& what) const;

@@ -272,8 +272,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         const double now = frame_timer.seconds();
         for (std::size_t r = 1; r < ranks; ++r)
             if (outstanding[r] > 0 && now - heard[r] > timeout)
-                session.abort("rank " + std::to_string(r) + " has returned no tile for " + std::to_string(int(timeout)) +
-                              " s, " + std::to_string(outstanding[r]) + " of its tiles outstanding (it stopped "
+                session.abort("rank " + std::to_string(r) + " has returned no tile for " + session.timeout_text() + ", " + std::to_string(outstanding[r]) + " of its tiles outstanding (it stopped "
                               "answering; --rank-timeout)");
         if (options.progress && gathered != reported) options.progress(reported = gathered, all_packets);
         if (completed == 0) std::this_thread::sleep_for(kPollInterval);
