@@ -265,24 +265,25 @@ Runner add_cache_study(CLI::App& app) {
         // are shared among the ranks (cluster.hpp); rank 0 alone prints and writes.
         std::string csv_path, md_path;
         cluster::together([&] {
-        checked_choices("--structures", o->structures, {"kd", "bih"});
-        checked_choices("--traversals", o->traversals, {"branched", "branchless"});
-        checked_choices("--access", o->access, {"sync", "async"});
-        checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
-        if (o->sample < 1 || o->sample > 1024)
-            throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
-        if (o->packet < 1 || o->packet > kMaxPacket)
-            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
-        check_threads(o->threads);
-        csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
-        md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
-        if (cluster::leader()) {
-            std::error_code ec;
-            std::filesystem::create_directories(o->out, ec);
-            if (!std::filesystem::is_directory(o->out, ec))
-                throw Error("--out '" + o->out + "': cannot create the folder");
-            for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
-        }
+            checked_choices("--structures", o->structures, {"kd", "bih"});
+            checked_choices("--traversals", o->traversals, {"branched", "branchless"});
+            checked_choices("--access", o->access, {"sync", "async"});
+            checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
+            if (o->sample < 1 || o->sample > 1024)
+                throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
+            if (o->packet < 1 || o->packet > kMaxPacket)
+                throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " +
+                            std::to_string(kMaxPacket) + "]");
+            check_threads(o->threads);
+            csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
+            md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
+            if (cluster::leader()) {
+                std::error_code ec;
+                std::filesystem::create_directories(o->out, ec);
+                if (!std::filesystem::is_directory(o->out, ec))
+                    throw Error("--out '" + o->out + "': cannot create the folder");
+                for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
+            }
         }, "checking the options");
         const unsigned threads = o->threads ? o->threads : cluster::cores();
 
@@ -297,31 +298,32 @@ Runner add_cache_study(CLI::App& app) {
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
             std::vector<Run> runs;
             cluster::together([&] {
-            if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
-            w = sampled_frame(scene, width, height, o->packet, o->sample);
-            if (cluster::leader()) std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): %zu "
-                        "primary + %zu shadow rays of the frame's %llu\n",
-                        scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
-                        PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample, w.primary.size(),
-                        w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
-            std::fflush(stdout);
-            for (const std::string& structure : o->structures) {
-                AccelConfig ac;
-                ac.kind = structure;
-                ac.threads = o->threads;
-                bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
-                for (const std::string& sweep : o->sweeps)
-                    for (const std::string& traversal : o->traversals)
-                        for (const std::string& access : o->access)
-                            for (const CacheLayout& layout : swept_layouts()) {
-                                Run run{structure, traversal, sweep, LocalStoreConfig{}};
-                                run.config.access = parse_cache_access("--access", access);
-                                run.config.batch_rays = static_cast<std::size_t>(o->packet) * o->packet;
-                                run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
-                                run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
-                                runs.push_back(run);
-                            }
-            }
+                if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
+                w = sampled_frame(scene, width, height, o->packet, o->sample);
+                if (cluster::leader())
+                    std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): "
+                                "%zu primary + %zu shadow rays of the frame's %llu\n",
+                                scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
+                                PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample,
+                                w.primary.size(), w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
+                std::fflush(stdout);
+                for (const std::string& structure : o->structures) {
+                    AccelConfig ac;
+                    ac.kind = structure;
+                    ac.threads = o->threads;
+                    bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
+                    for (const std::string& sweep : o->sweeps)
+                        for (const std::string& traversal : o->traversals)
+                            for (const std::string& access : o->access)
+                                for (const CacheLayout& layout : swept_layouts()) {
+                                    Run run{structure, traversal, sweep, LocalStoreConfig{}};
+                                    run.config.access = parse_cache_access("--access", access);
+                                    run.config.batch_rays = static_cast<std::size_t>(o->packet) * o->packet;
+                                    run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
+                                    run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
+                                    runs.push_back(run);
+                                }
+                }
             }, "building the structures");
             Timer timer;
             const std::vector<Result> results = trace_shared(bases, runs, w, threads);

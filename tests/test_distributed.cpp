@@ -22,8 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 
 struct TempDir {
-    fs::path path = fs::temp_directory_path() / ("cellrt_mpi_" + std::to_string(::getpid()) + "_" +
-                                                 std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+    fs::path path = fs::temp_directory_path() /
+                    ("cellrt_mpi_" + std::to_string(::getpid()) + "_" +
+                     std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
     TempDir() { fs::create_directories(path); }
     ~TempDir() { fs::remove_all(path); }
 };

@@ -100,7 +100,8 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
 
 std::vector<std::size_t> share(std::size_t count) {
     std::vector<std::size_t> mine;
-    for (auto i = static_cast<std::size_t>(rank()); i < count; i += static_cast<std::size_t>(ranks())) mine.push_back(i);
+    for (auto i = static_cast<std::size_t>(rank()); i < count; i += static_cast<std::size_t>(ranks()))
+        mine.push_back(i);
     return mine;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -149,6 +150,12 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     };
     Outbox outbox;
     Image tile;
+    std::unique_ptr<FrameRenderer> renderer;
+    try {
+        renderer = std::make_unique<FrameRenderer>(scene, accel, o);
+    } catch (const std::exception& e) {
+        failure = e.what();
+    }
     bool first = true;
     while (!queue.empty() || pending > 0) {
         take(queue.empty());
@@ -162,7 +169,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
         if (!failure) {
             try {
                 RenderStats s;
-                render_window(scene, accel, o, grid.rect(static_cast<std::size_t>(t)), tile, &s);
+                renderer->render_window(grid.rect(static_cast<std::size_t>(t)), tile, &s);
                 add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                 header.outcome = Outcome::traced;
                 bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
@@ -203,11 +210,18 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     load.threads = o.threads;
     std::thread local([&] {
         Image tile;
+        std::unique_ptr<FrameRenderer> renderer;
+        try {
+            renderer = std::make_unique<FrameRenderer>(scene, accel, o);
+        } catch (const std::exception& e) {
+            failure = e.what();
+            stop = true;
+        }
         for (std::int32_t t = claim(); t != kNoTile; t = claim()) {
             try {
                 RenderStats s;
                 const PixelRect r = grid.rect(static_cast<std::size_t>(t));
-                render_window(scene, accel, o, r, tile, &s);
+                renderer->render_window(r, tile, &s);
                 copy_into(frame, r, tile.pixels.data());
                 add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                 gathered += grid.packets(static_cast<std::size_t>(t));
@@ -249,7 +263,8 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         const bool remote = std::any_of(outstanding.begin(), outstanding.end(), [](std::size_t n) { return n > 0; });
         if (!remote && local_done) break;
         int completed = 0;
-        if (remote) MPI_Testsome(static_cast<int>(ranks), requests.data(), &completed, indices.data(), MPI_STATUSES_IGNORE);
+        if (remote)
+            MPI_Testsome(static_cast<int>(ranks), requests.data(), &completed, indices.data(), MPI_STATUSES_IGNORE);
         if (completed == MPI_UNDEFINED) completed = 0;
         for (int i = 0; i < completed; ++i) {
             const auto r = static_cast<std::size_t>(indices[static_cast<std::size_t>(i)]);
@@ -272,8 +287,9 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         const double now = frame_timer.seconds();
         for (std::size_t r = 1; r < ranks; ++r)
             if (outstanding[r] > 0 && now - heard[r] > timeout)
-                session.abort("rank " + std::to_string(r) + " has returned no tile for " + session.timeout_text() + ", " + std::to_string(outstanding[r]) + " of its tiles outstanding (it stopped "
-                              "answering; --rank-timeout)");
+                session.abort("rank " + std::to_string(r) + " has returned no tile for " + session.timeout_text() +
+                              ", " + std::to_string(outstanding[r]) +
+                              " of its tiles outstanding (it stopped answering; --rank-timeout)");
         if (options.progress && gathered != reported) options.progress(reported = gathered, all_packets);
         if (completed == 0) std::this_thread::sleep_for(kPollInterval);
     }
@@ -333,9 +349,11 @@ unsigned rank_threads(unsigned threads) {
 void render_tiles(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
                   const TileOptions& tiles, Image& frame, RenderStats* stats, std::vector<RankLoad>* loads) {
     if (tiles.tile < 1 || tiles.tile > kMaxImageSide)
-        throw Error("tile edge " + std::to_string(tiles.tile) + " must lie in [1, " + std::to_string(kMaxImageSide) + "]");
+        throw Error("tile edge " + std::to_string(tiles.tile) + " must lie in [1, " + std::to_string(kMaxImageSide) +
+                    "]");
     if (tiles.ahead < 1 || tiles.ahead > kMaxAhead)
-        throw Error("tiles ahead " + std::to_string(tiles.ahead) + " must lie in [1, " + std::to_string(kMaxAhead) + "]");
+        throw Error("tiles ahead " + std::to_string(tiles.ahead) + " must lie in [1, " + std::to_string(kMaxAhead) +
+                    "]");
     check_image_size(options.width, options.height);
     static_cast<void>(PacketGrid(options.width, options.height, options.packet));  // refuses a bad packet edge
     const TileGrid grid{options.width, options.height, tiles.tile, options.packet};
@@ -343,7 +361,8 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
     Timer timer;
     RankLoad mine;
     if (session.leader()) {
-        if (frame.width != options.width || frame.height != options.height) frame = Image(options.width, options.height);
+        if (frame.width != options.width || frame.height != options.height)
+            frame = Image(options.width, options.height);
         mine = master(session, scene, accel, options, grid, tiles.ahead, frame, failure);
     } else {
         mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, failure);

@@ -3,8 +3,9 @@
 // each rank `ahead` tiles at the start and one more for every tile a rank returns, so a rank always
 // has the next tile at hand while its last result travels (asking ahead); it gathers the tiles into
 // the frame. Every rank, rank 0 included (on a thread of its own beside the master), traces a tile
-// on all its cores through the process's scheduler (render_window). A pixel's colour depends only on
-// its own rays, so the frame is the one-process frame, bit for bit, for every number of ranks.
+// on all its cores through the process's scheduler (FrameRenderer::render_window). A pixel's colour
+// depends only on its own rays, so the frame is the one-process frame, bit for bit, for every number
+// of ranks.
 #pragma once
 
 #include <cstddef>
@@ -27,7 +28,7 @@ inline constexpr int kMaxAhead = 64;
 struct RankLoad {
     unsigned threads = 0;
     std::uint64_t tiles = 0, packets = 0, secondary_rays = 0;
-    double busy_seconds = 0.0;     // tracing its tiles (render_window)
+    double busy_seconds = 0.0;     // tracing its tiles (FrameRenderer::render_window)
     double seconds = 0.0;          // from the frame's start on this rank until it had no tile left
     std::vector<WorkerLoad> workers;  // its threads' packets and time tracing, summed over its tiles
 };
