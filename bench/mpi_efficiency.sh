@@ -46,5 +46,7 @@ for n in names:
     print(f"{n:16} {med(t):9.3f} {min(t):6.3f} {max(t):6.3f} {med(t) / base[0]:6.3f} {frame_cpu:12.3f} {frame_cpu / base[1]:6.3f}")
     if "ranks" in runs[-1]:
         for k in runs[-1]["ranks"]:
-            print(f"    rank {k['rank']}: {k['threads']} threads, {k['tiles']} tiles, busy {k['busy_seconds']:.3f} s of {k['seconds']:.3f} s")
+            print(f"    rank {k['rank']}: {k['threads']} threads, {k['tiles']} tiles, busy {k['busy_seconds']:.3f} s of "
+                  f"{k['seconds']:.3f} s, CPU {k['cpu_seconds']:.3f} s" +
+                  (f" (master {k['master_cpu_seconds']:.3f} s)" if "master_cpu_seconds" in k else ""))
 PY

@@ -94,7 +94,9 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
                                    {"packets", l.packets},
                                    {"secondary_rays", l.secondary_rays},
                                    {"busy_seconds", l.busy_seconds},
-                                   {"seconds", l.seconds}});
+                                   {"seconds", l.seconds},
+                                   {"cpu_seconds", l.cpu_seconds}});
+        if (r == 0) report["ranks"].back()["master_cpu_seconds"] = l.master_cpu_seconds;
     }
 }
 

@@ -1,6 +1,7 @@
 #include "distributed/tile_farm.hpp"
 
 #include <sched.h>
+#include <time.h>
 
 #include <algorithm>
 #include <atomic>
@@ -108,6 +109,12 @@ private:
     std::deque<Send> sends_;
 };
 
+double cpu_seconds(clockid_t clock) {
+    timespec t{};
+    clock_gettime(clock, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 std::string int_bytes(std::int32_t v) { return std::string(reinterpret_cast<const char*>(&v), sizeof v); }
 
 RenderOptions tile_options(const RenderOptions& options) {
@@ -126,6 +133,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     RankLoad load;
     load.threads = o.threads;
     Timer frame_timer;
+    const double cpu_start = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
     std::deque<std::int32_t> queue;
     int pending = ahead;  // answers rank 0 still owes this rank
     std::int32_t incoming = kNoTile;
@@ -185,6 +193,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     }
     outbox.flush(session, "rank 0's receipt of the last tiles");
     load.seconds = frame_timer.seconds();
+    load.cpu_seconds = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
     return load;
 }
 
@@ -196,6 +205,8 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     std::size_t all_packets = 0;
     for (std::size_t t = 0; t < count; ++t) all_packets += grid.packets(t);
     Timer frame_timer;
+    const double cpu_start = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    const double master_start = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
     std::atomic<std::size_t> next{0}, gathered{0};
     std::atomic<bool> stop{false}, local_done{false};
     auto claim = [&]() -> std::int32_t {
@@ -237,7 +248,17 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     // The other ranks' tiles: `ahead` each at the start, then one per tile returned.
     Outbox outbox;
     std::vector<std::size_t> outstanding(ranks, 0);
-    std::vector<double> heard(ranks, 0.0);
+    std::vector<double> heard(ranks, 0.0), gap(ranks, 0.0);  // last result, mean time between results
+    // The master polls often enough to answer a rank before its queued tiles run out, and no more
+    // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md).
+    auto poll_interval = [&] {
+        double fastest = 0.0;
+        for (std::size_t r = 1; r < ranks; ++r)
+            if (gap[r] > 0.0 && (fastest == 0.0 || gap[r] < fastest)) fastest = gap[r];
+        if (fastest == 0.0) return kPollInterval;
+        const double seconds = std::clamp(fastest * (ahead - 1) / 4.0, 100e-6, 2e-3);
+        return std::chrono::microseconds(static_cast<long long>(seconds * 1e6));
+    };
     std::size_t max_tile_pixels = 0;
     for (std::size_t t = 0; t < count; ++t)
         max_tile_pixels = std::max(max_tile_pixels, static_cast<std::size_t>(grid.rect(t).pixels()));
@@ -271,7 +292,9 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
             ResultHeader header;
             std::memcpy(&header, buffers[r].data(), sizeof header);
             --outstanding[r];
-            heard[r] = frame_timer.seconds();
+            const double now = frame_timer.seconds();
+            gap[r] = gap[r] > 0.0 ? 0.75 * gap[r] + 0.25 * (now - heard[r]) : now - heard[r];
+            heard[r] = now;
             if (header.outcome == Outcome::traced) {
                 const auto t = static_cast<std::size_t>(header.tile);
                 copy_into(frame, grid.rect(t), reinterpret_cast<const Vec3*>(buffers[r].data() + sizeof header));
@@ -291,10 +314,12 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
                               ", " + std::to_string(outstanding[r]) +
                               " of its tiles outstanding (it stopped answering; --rank-timeout)");
         if (options.progress && gathered != reported) options.progress(reported = gathered, all_packets);
-        if (completed == 0) std::this_thread::sleep_for(kPollInterval);
+        if (completed == 0) std::this_thread::sleep_for(poll_interval());
     }
     local.join();
     outbox.flush(session, "the last tiles' answers");
+    load.cpu_seconds = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
+    load.master_cpu_seconds = cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - master_start;
     return load;
 }
 
@@ -307,6 +332,8 @@ std::string load_bytes(const RankLoad& load) {
     put(load.secondary_rays);
     put(load.busy_seconds);
     put(load.seconds);
+    put(load.cpu_seconds);
+    put(load.master_cpu_seconds);
     for (const WorkerLoad& w : load.workers) {
         put(w.packets);
         put(w.busy_seconds);
@@ -327,6 +354,8 @@ RankLoad parse_load(const std::string& bytes) {
     get(load.secondary_rays);
     get(load.busy_seconds);
     get(load.seconds);
+    get(load.cpu_seconds);
+    get(load.master_cpu_seconds);
     while (at + sizeof(std::size_t) + sizeof(double) <= bytes.size()) {
         WorkerLoad w;
         get(w.packets);

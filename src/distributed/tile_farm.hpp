@@ -30,6 +30,8 @@ struct RankLoad {
     std::uint64_t tiles = 0, packets = 0, secondary_rays = 0;
     double busy_seconds = 0.0;     // tracing its tiles (FrameRenderer::render_window)
     double seconds = 0.0;          // from the frame's start on this rank until it had no tile left
+    double cpu_seconds = 0.0;      // the process's CPU time in that span, every thread's
+    double master_cpu_seconds = 0.0;  // rank 0: its master thread's share of it
     std::vector<WorkerLoad> workers;  // its threads' packets and time tracing, summed over its tiles
 };
 
