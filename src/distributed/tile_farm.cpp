@@ -29,8 +29,9 @@ enum class Outcome : std::int32_t { traced, failed, skipped };
 struct ResultHeader {
     std::int32_t tile;
     Outcome outcome;
+    double seconds;  // the rank's time tracing the tile
 };
-static_assert(sizeof(ResultHeader) == 8);
+static_assert(sizeof(ResultHeader) == 16);
 
 // The longest cause a failed tile carries.
 constexpr std::size_t kMaxCause = 4096;
@@ -173,13 +174,14 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
         const std::int32_t t = queue.front();
         queue.pop_front();
         std::string bytes(sizeof(ResultHeader), '\0');
-        ResultHeader header{t, Outcome::skipped};
+        ResultHeader header{t, Outcome::skipped, 0.0};
         if (!failure) {
             try {
                 RenderStats s;
                 renderer->render_window(grid.rect(static_cast<std::size_t>(t)), tile, &s);
                 add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                 header.outcome = Outcome::traced;
+                header.seconds = s.seconds;
                 bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
             } catch (const std::exception& e) {
                 failure = e.what();
@@ -248,13 +250,14 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     // The other ranks' tiles: `ahead` each at the start, then one per tile returned.
     Outbox outbox;
     std::vector<std::size_t> outstanding(ranks, 0);
-    std::vector<double> heard(ranks, 0.0), gap(ranks, 0.0);  // last result, mean time between results
+    std::vector<double> heard(ranks, 0.0), tile_time(ranks, 0.0);  // last result; a tile's mean time
     // The master polls often enough to answer a rank before its queued tiles run out, and no more
-    // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md).
+    // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md). The ranks' own tracing
+    // times set it, not the gaps between their results, which grow when a rank waits.
     auto poll_interval = [&] {
         double fastest = 0.0;
         for (std::size_t r = 1; r < ranks; ++r)
-            if (gap[r] > 0.0 && (fastest == 0.0 || gap[r] < fastest)) fastest = gap[r];
+            if (tile_time[r] > 0.0 && (fastest == 0.0 || tile_time[r] < fastest)) fastest = tile_time[r];
         if (fastest == 0.0) return kPollInterval;
         const double seconds = std::clamp(fastest * (ahead - 1) / 4.0, 100e-6, 2e-3);
         return std::chrono::microseconds(static_cast<long long>(seconds * 1e6));
@@ -292,9 +295,9 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
             ResultHeader header;
             std::memcpy(&header, buffers[r].data(), sizeof header);
             --outstanding[r];
-            const double now = frame_timer.seconds();
-            gap[r] = gap[r] > 0.0 ? 0.75 * gap[r] + 0.25 * (now - heard[r]) : now - heard[r];
-            heard[r] = now;
+            heard[r] = frame_timer.seconds();
+            if (header.outcome == Outcome::traced)
+                tile_time[r] = tile_time[r] > 0.0 ? 0.75 * tile_time[r] + 0.25 * header.seconds : header.seconds;
             if (header.outcome == Outcome::traced) {
                 const auto t = static_cast<std::size_t>(header.tile);
                 copy_into(frame, grid.rect(t), reinterpret_cast<const Vec3*>(buffers[r].data() + sizeof header));

@@ -19,7 +19,7 @@ namespace cellrt::distributed {
 
 struct TileOptions {
     int tile = 128;  // tile edge in pixels (the frame's edge tiles are cut to it)
-    int ahead = 2;   // tiles a rank holds: the one it traces and those queued behind it
+    int ahead = 3;   // tiles a rank holds: the one it traces and those queued behind it
 };
 
 inline constexpr int kMaxAhead = 64;
