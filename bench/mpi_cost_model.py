@@ -3,7 +3,7 @@
 
 The per-frame terms are fitted to bench/mpi_efficiency.sh's figures (one process, 2 ranks with 128-
 and 64-pixel tiles); the network's are assumed (an InfiniBand-class fabric) and given as options.
-For each N the tile edge (of 128, 64, 32, 16) that gives the shortest frame is chosen.
+For each N the tile edge (of 256, 128, 64, 32, 16) that gives the shortest frame is chosen.
 
   python3 bench/mpi_cost_model.py --frame-cpu 0.44 --tile-cpu 0.0001 [--cores 2] [--size 1920x1080]
 """
@@ -51,7 +51,7 @@ def main():
     print("|---:|---:|---:|---:|---:|---:|---:|")
     for k in range(1, 11):
         n = 2 ** k
-        best = min((frame_time(n, a, e) + (e,) for e in (128, 64, 32, 16)), key=lambda r: r[0])
+        best = min((frame_time(n, a, e) + (e,) for e in (256, 128, 64, 32, 16)), key=lambda r: r[0])
         t, tiles, edge = best
         bcast = math.ceil(math.log2(n)) * (a.latency + a.scene_bytes / a.bandwidth)
         print(f"| {n} | {edge} | {tiles} | {t * 1e3:.2f} | {t1 / t:.1f} | {t1 / t / n:.2f} | {bcast * 1e3:.2f} |")
