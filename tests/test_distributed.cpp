@@ -179,11 +179,11 @@ TEST_F(Distributed, ARankThatStopsAnsweringTimesOut) {
     const fs::path out = dir.path / "frame.png";
     const auto start = std::chrono::steady_clock::now();
     const Outcome o = shell(mpirun(3, "-x CELLRT_MPI_FAULT=stall:2") + mpi + " render " + kScene +
-                                " --size 200x200 --tile 8 --rank-timeout 1 -o " + out.string(), dir.path);
+                                " --size 200x200 --tile 8 --rank-timeout 2 -o " + out.string(), dir.path);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_NE(o.status, 0) << o.err;
     EXPECT_EQ(count(o.err, "cellrt: error:"), 1u) << o.err;
-    EXPECT_NE(o.err.find("cellrt: error: rank 0: rank 2 has returned no tile for 1 s"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("cellrt: error: rank 0: rank 2 has returned no tile for 2 s"), std::string::npos) << o.err;
     EXPECT_LT(seconds, 30.0);
     EXPECT_FALSE(fs::exists(out));
 }

@@ -31,11 +31,23 @@ std::string Session::timeout_text() const {
     return text;
 }
 
+namespace {
+
+// Rank 0's word, before it ends the job, that it has said why: the others then end without a word.
+constexpr int kTagAbort = 7;
+
+}  // namespace
+
 void Session::wait(MPI_Request& request, const std::string& what) const {
     const double limit = static_cast<double>(timeout_.count()) / 1e3 * (leader() ? 1.0 : 2.0);
     Timer timer;
     int done = 0;
     for (MPI_Test(&request, &done, MPI_STATUS_IGNORE); !done; MPI_Test(&request, &done, MPI_STATUS_IGNORE)) {
+        if (!leader()) {
+            int aborting = 0;
+            MPI_Iprobe(0, kTagAbort, MPI_COMM_WORLD, &aborting, MPI_STATUS_IGNORE);
+            if (aborting) std::_Exit(1);  // rank 0 has printed the cause and is ending the job
+        }
         if (timer.seconds() > limit)
             abort("no answer to " + what + " within " + (leader() ? "" : "twice ") + timeout_text() +
                   " (a rank stopped answering; --rank-timeout)");
@@ -46,6 +58,14 @@ void Session::wait(MPI_Request& request, const std::string& what) const {
 void Session::abort(const std::string& message) const {
     std::fprintf(stderr, "cellrt: error: rank %d: %s\n", rank_, message.c_str());
     std::fflush(stderr);
+    if (leader()) {
+        static const char word = 0;
+        for (int r = 1; r < size_; ++r) {
+            MPI_Request request;
+            MPI_Isend(&word, 1, MPI_CHAR, r, kTagAbort, MPI_COMM_WORLD, &request);
+            MPI_Request_free(&request);
+        }
+    }
     MPI_Abort(MPI_COMM_WORLD, 1);
     std::_Exit(1);  // MPI_Abort does not return; this only tells the compiler so
 }

@@ -56,7 +56,8 @@ public:
     // stopped answering cannot take part in an orderly end).
     void wait(MPI_Request& request, const std::string& what) const;
 
-    // Prints "cellrt: error: rank R: MESSAGE" and ends the whole job with status 1.
+    // Prints "cellrt: error: rank R: MESSAGE" and ends the whole job with status 1. Rank 0 first tells
+    // the others, which then end at their next wait without a message of their own.
     [[noreturn]] void abort(const std::string& message) const;
 
     // Every rank's outcome of one step (each rank calls it once per step, in the same order): returns
