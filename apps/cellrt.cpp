@@ -1,4 +1,5 @@
-// The cellrt command-line program: one subcommand per file (cmd_*.cpp), registered here.
+// The cellrt program and cellrt-mpi (the same commands over MPI ranks, apps/cluster.hpp): one subcommand
+// per file (cmd_*.cpp), registered here.
 #include <csignal>
 #include <cstdio>
 #include <exception>
