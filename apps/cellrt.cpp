@@ -1,16 +1,18 @@
-// The cellrt command-line program: one subcommand per file (cmd_*.cpp), registered here.
+// The cellrt program and cellrt-mpi (the same commands over MPI ranks, apps/cluster.hpp): one subcommand
+// per file (cmd_*.cpp), registered here.
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <sstream>
 
 #include "cellrt/error.hpp"
 #include "cli.hpp"
+#include "cluster.hpp"
 
 namespace {
 extern "C" void on_interrupt(int) { cellrt::cli::g_cancel.store(true); }
-}  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     using namespace cellrt;
     CLI::App app{"cellrt: kd-tree and BIH ray tracing kernels after 'Data structures for ray tracing on Cell "
                  "architecture' (M. Hapala)"};
@@ -21,7 +23,9 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        if (cli::cluster::leader()) return app.exit(e);
+        std::ostringstream silent;  // every rank parsed the same command line; rank 0 speaks for all
+        return app.exit(e, silent, silent);
     }
     const auto subcommands = app.get_subcommands({});
     std::size_t chosen = 0;
@@ -30,17 +34,35 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
     try {
+        // Under MPI only the commands whose work splits over the ranks run (docs/DISTRIBUTED.md).
+        static const char* const kNames[] = {"render", "info", "profile", "cache-study"};
+        cli::cluster::together([&] {
+            if (cli::cluster::ranks() > 1 && (chosen == 1 || chosen == 2))
+                throw Error(std::string(kNames[chosen]) + " runs in one process: run it with cellrt, not under mpirun");
+        }, "choosing the command");
         return runners.at(chosen)();
     } catch (const Error& e) {
-        std::fprintf(stderr, "cellrt: error: %s\n", e.what());
+        cli::cluster::print_error(e);
         return cli::g_cancel.load() ? 130 : 1;
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "cellrt: error: out of memory\n");
+        cli::cluster::print_error(Error("out of memory"));
         return 1;
     } catch (const std::exception& e) {
         // What the library did not turn into a cellrt::Error where it was thrown (each one found is
         // a bug, fixed there) still ends with one line and status 1, not in std::terminate.
+        cli::cluster::print_error(e);
+        return 1;
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        cellrt::cli::cluster::start(argc, argv);
+    } catch (const std::exception& e) {
         std::fprintf(stderr, "cellrt: error: %s\n", e.what());
         return 1;
     }
+    return cellrt::cli::cluster::finish(run(argc, argv));
 }

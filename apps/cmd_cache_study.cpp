@@ -12,6 +12,7 @@
 // tracing the sample in order, so its figures are reproducible; runs are spread over --threads
 // threads.
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <cstdio>
 #include <exception>
@@ -20,6 +21,7 @@
 #include <map>
 #include <system_error>
 #include <thread>
+#include <type_traits>
 #include <unistd.h>
 
 #include "accel/local_store_registry.hpp"
@@ -29,6 +31,7 @@
 #include "cellrt/scene.hpp"
 #include "cellrt/workload.hpp"
 #include "cli.hpp"
+#include "cluster.hpp"
 
 namespace cellrt::cli {
 namespace {
@@ -126,6 +129,33 @@ std::vector<Result> trace_all(const std::map<std::string, std::unique_ptr<LocalS
     for (auto& t : pool) t.join();
     if (failure) std::rethrow_exception(failure);
     if (g_cancel) throw Error("cache study cancelled");
+    return results;
+}
+
+// trace_all over this process's share of the runs (all of them in the plain program; under MPI every
+// ranks()-th), the results gathered on the leader in the order of `runs` (empty elsewhere).
+std::vector<Result> trace_shared(const std::map<std::string, std::unique_ptr<LocalStoreAccelerator>>& bases,
+                                 const std::vector<Run>& runs, const FrameRays& w, unsigned threads) {
+    static_assert(std::is_trivially_copyable_v<Result>);
+    const std::vector<std::size_t> mine = cluster::share(runs.size());
+    std::vector<Run> my_runs;
+    for (std::size_t i : mine) my_runs.push_back(runs[i]);
+    std::vector<Result> my_results;
+    cluster::together([&] { my_results = trace_all(bases, my_runs, w, threads); }, "tracing the runs");
+    std::string bytes;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+        bytes.append(reinterpret_cast<const char*>(&mine[k]), sizeof mine[k]);
+        bytes.append(reinterpret_cast<const char*>(&my_results[k]), sizeof my_results[k]);
+    }
+    const std::vector<std::string> all = cluster::gather(bytes);
+    std::vector<Result> results(cluster::leader() ? runs.size() : 0);
+    for (const std::string& b : all)
+        for (std::size_t at = 0; at + sizeof(std::size_t) + sizeof(Result) <= b.size();
+             at += sizeof(std::size_t) + sizeof(Result)) {
+            std::size_t i;
+            std::memcpy(&i, b.data() + at, sizeof i);
+            std::memcpy(&results.at(i), b.data() + at + sizeof i, sizeof(Result));
+        }
     return results;
 }
 
@@ -229,61 +259,80 @@ Runner add_cache_study(CLI::App& app) {
     cmd->add_option("--sweeps", o->sweeps, "Caches swept: node (Graphs 5-1..5-6), triangle (5-7..5-10)")
         ->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace existing output files");
+    cluster::add_sweep_options(*cmd);
     return [o] {
-        checked_choices("--structures", o->structures, {"kd", "bih"});
-        checked_choices("--traversals", o->traversals, {"branched", "branchless"});
-        checked_choices("--access", o->access, {"sync", "async"});
-        checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
-        if (o->sample < 1 || o->sample > 1024)
-            throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
-        if (o->packet < 1 || o->packet > kMaxPacket)
-            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
-        check_threads(o->threads);
-        std::error_code ec;
-        std::filesystem::create_directories(o->out, ec);
-        if (!std::filesystem::is_directory(o->out, ec)) throw Error("--out '" + o->out + "': cannot create the folder");
-        const std::string csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
-        const std::string md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
-        for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
-        const unsigned threads = o->threads ? o->threads : std::max(1u, std::thread::hardware_concurrency());
+        // Under MPI each step runs on every rank, a step that fails on one fails on all, and the runs
+        // are shared among the ranks (cluster.hpp); rank 0 alone prints and writes.
+        std::string csv_path, md_path;
+        cluster::together([&] {
+            checked_choices("--structures", o->structures, {"kd", "bih"});
+            checked_choices("--traversals", o->traversals, {"branched", "branchless"});
+            checked_choices("--access", o->access, {"sync", "async"});
+            checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
+            if (o->sample < 1 || o->sample > 1024)
+                throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
+            if (o->packet < 1 || o->packet > kMaxPacket)
+                throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " +
+                            std::to_string(kMaxPacket) + "]");
+            check_threads(o->threads);
+            csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
+            md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
+            if (cluster::leader()) {
+                std::error_code ec;
+                std::filesystem::create_directories(o->out, ec);
+                if (!std::filesystem::is_directory(o->out, ec))
+                    throw Error("--out '" + o->out + "': cannot create the folder");
+                for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
+            }
+        }, "checking the options");
+        const unsigned threads = o->threads ? o->threads : cluster::cores();
 
         std::string csv = csv_header();
         std::string md = "| scene | structure | traversal | access | cache | best layout: hit ratio, cycles/ray | best "
                          "direct-mapped | the study's layout | study / best |\n|---|---|---|---|---|---|---|---|---|\n";
         Timer total;
         for (const std::string& spec : o->scenes) {
-            const Scene scene = load_scene(spec);
+            const Scene scene = cluster::load_scene(spec);
             int width = scene.width, height = scene.height;
-            if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
-            const FrameRays w = sampled_frame(scene, width, height, o->packet, o->sample);
-            std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): %zu "
-                        "primary + %zu shadow rays of the frame's %llu\n",
-                        scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
-                        PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample, w.primary.size(),
-                        w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
-            std::fflush(stdout);
+            FrameRays w;
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
             std::vector<Run> runs;
-            for (const std::string& structure : o->structures) {
-                AccelConfig ac;
-                ac.kind = structure;
-                ac.threads = o->threads;
-                bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
-                for (const std::string& sweep : o->sweeps)
-                    for (const std::string& traversal : o->traversals)
-                        for (const std::string& access : o->access)
-                            for (const CacheLayout& layout : swept_layouts()) {
-                                Run run{structure, traversal, sweep, LocalStoreConfig{}};
-                                run.config.access = parse_cache_access("--access", access);
-                                run.config.batch_rays = static_cast<std::size_t>(o->packet) * o->packet;
-                                run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
-                                run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
-                                runs.push_back(run);
-                            }
-            }
+            cluster::together([&] {
+                if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
+                w = sampled_frame(scene, width, height, o->packet, o->sample);
+                if (cluster::leader())
+                    std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): "
+                                "%zu primary + %zu shadow rays of the frame's %llu\n",
+                                scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
+                                PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample,
+                                w.primary.size(), w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
+                std::fflush(stdout);
+                for (const std::string& structure : o->structures) {
+                    AccelConfig ac;
+                    ac.kind = structure;
+                    ac.threads = o->threads;
+                    bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
+                    for (const std::string& sweep : o->sweeps)
+                        for (const std::string& traversal : o->traversals)
+                            for (const std::string& access : o->access)
+                                for (const CacheLayout& layout : swept_layouts()) {
+                                    Run run{structure, traversal, sweep, LocalStoreConfig{}};
+                                    run.config.access = parse_cache_access("--access", access);
+                                    run.config.batch_rays = static_cast<std::size_t>(o->packet) * o->packet;
+                                    run.config.node_cache = sweep == "node" ? layout : study_node_layout(structure);
+                                    run.config.triangle_cache = sweep == "node" ? kFixedTriangleLayout : layout;
+                                    runs.push_back(run);
+                                }
+                }
+            }, "building the structures");
             Timer timer;
-            const std::vector<Result> results = trace_all(bases, runs, w, threads);
-            std::printf("  %zu runs in %.1f s on %u threads\n", runs.size(), timer.seconds(), threads);
+            const std::vector<Result> results = trace_shared(bases, runs, w, threads);
+            if (!cluster::leader()) continue;
+            if (cluster::ranks() == 1)
+                std::printf("  %zu runs in %.1f s on %u threads\n", runs.size(), timer.seconds(), threads);
+            else
+                std::printf("  %zu runs in %.1f s on %d ranks of %u threads\n", runs.size(), timer.seconds(),
+                            cluster::ranks(), threads);
             std::fflush(stdout);
             std::map<std::string, std::vector<std::size_t>> groups;  // runs of one sweep, in order
             std::vector<std::string> group_order;
@@ -296,6 +345,7 @@ Runner add_cache_study(CLI::App& app) {
             }
             for (const std::string& key : group_order) md += best_layout_line(scene.name, runs, results, groups[key]);
         }
+        if (!cluster::leader()) return 0;
         write_file_atomically(csv_path, csv, o->overwrite);
         write_file_atomically(md_path, md, o->overwrite);
         std::printf("\n%s\nwrote %s and %s in %.1f s; draw the graphs with:\n"

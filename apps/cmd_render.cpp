@@ -13,6 +13,7 @@
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
+#include "cluster.hpp"
 
 namespace cellrt::cli {
 namespace {
@@ -185,47 +186,65 @@ Runner add_render(CLI::App& app) {
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
     cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE");
+    cluster::add_render_options(*cmd);
     return [o, ao_samples] {
-        const ShadingOptions shading = parse_shading_options(o->shading, o->ao_samples, *ao_samples);
-        if (o->packet < 1 || o->packet > kMaxPacket)
-            throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
-        const LocalStoreConfig local_store = o->local_store.config(o->packet);
-        check_output(o->out, o->overwrite);
-        if (!o->stats.empty()) check_output(o->stats, o->overwrite);
+        // Under MPI each step runs on every rank, and a step that fails on one fails on all
+        // (cluster.hpp); rank 0 alone checks and writes the outputs.
+        ShadingOptions shading;
+        LocalStoreConfig local_store;
+        cluster::together([&] {
+            shading = parse_shading_options(o->shading, o->ao_samples, *ao_samples);
+            if (o->packet < 1 || o->packet > kMaxPacket)
+                throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) +
+                            "]");
+            local_store = o->local_store.config(o->packet);
+            if (o->local_store.enabled && cluster::ranks() > 1)
+                throw Error("--local-store models one process's workers: run it with cellrt, not under mpirun");
+            if (cluster::leader()) {
+                check_output(o->out, o->overwrite);
+                if (!o->stats.empty()) check_output(o->stats, o->overwrite);
+            }
+        }, "checking the options");
         Timer load_timer;
-        const Scene scene = load_scene(o->scene);
+        const Scene scene = cluster::load_scene(o->scene);
         const double load_s = load_timer.seconds();
         RenderOptions ro;
-        ro.width = scene.width;
-        ro.height = scene.height;
-        if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o->size);
-        ro.threads = o->accel.threads;
-        ro.packet = o->packet;
-        ro.shading = shading;
-        try {
-            ro.dispatch = parse_dispatch(o->dispatch);
-        } catch (const Error& e) {
-            throw option_error("--dispatch", e);
-        }
-        ro.pin = o->pin;
-        ro.cancel = &g_cancel;
         std::unique_ptr<LocalStoreAccelerator> modelled;
-        if (o->local_store.enabled && o->accel.device != "cpu")
-            throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
-                        o->accel.device);
-        if (o->local_store.enabled) {
-            // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
-            AccelConfig config = o->accel.config();
-            if (o->accel.simd_option->count() == 0) config.simd = "off";
-            modelled = make_local_store_accelerator(scene.triangles, config, local_store);
-        }
-        const std::unique_ptr<Accelerator> direct =
-            modelled ? nullptr : build_structure(scene.triangles, o->accel.config());
+        std::unique_ptr<Accelerator> direct;
+        cluster::together([&] {
+            ro.width = scene.width;
+            ro.height = scene.height;
+            if (!o->size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o->size);
+            ro.threads = o->accel.threads;
+            ro.packet = o->packet;
+            ro.shading = shading;
+            try {
+                ro.dispatch = parse_dispatch(o->dispatch);
+            } catch (const Error& e) {
+                throw option_error("--dispatch", e);
+            }
+            ro.pin = o->pin;
+            ro.cancel = &g_cancel;
+            if (o->local_store.enabled && o->accel.device != "cpu")
+                throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
+                            o->accel.device);
+            if (o->local_store.enabled) {
+                // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
+                AccelConfig config = o->accel.config();
+                if (o->accel.simd_option->count() == 0) config.simd = "off";
+                modelled = make_local_store_accelerator(scene.triangles, config, local_store);
+            } else {
+                direct = build_structure(scene.triangles, o->accel.config());
+            }
+        }, "building the structure");
         const Accelerator& accel = modelled ? *modelled : *direct;
         Progress progress;
-        ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };
+        if (cluster::leader()) ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };
         RenderStats rs;
-        const Image image = render(scene, accel, ro, &rs);
+        Image image;
+        nlohmann::json ranks_report = nlohmann::json::object();
+        cluster::render(scene, accel, ro, image, rs, ranks_report);
+        if (!cluster::leader()) return 0;
         write_image(image, o->out, o->overwrite);
         const AccelStats st = accel.stats();
         std::printf("%s: %zu triangles, %dx%d, %s, load %.3f s, build %.3f s, render %.3f s (%.2f Mrays/s) -> %s\n",
@@ -252,6 +271,7 @@ Runner add_render(CLI::App& app) {
                                         {"started_seconds", w.started_seconds},
                                         {"finished_seconds", w.finished_seconds}});
             if (modelled) j["local_store"] = local_store_json(*modelled);
+            j.update(ranks_report);  // under MPI: the tiles, and what each rank did
             write_file_atomically(o->stats, json_report(j), o->overwrite);
         }
         return 0;

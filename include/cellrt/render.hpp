@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 
 #include "cellrt/accel.hpp"
 #include "cellrt/image.hpp"
@@ -51,6 +52,32 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
 // after frame keeps its frame buffer; a fresh 512 x 512 buffer costs hundreds of page faults).
 void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
             RenderStats* stats = nullptr);
+
+// The pixels of `window` only, a rectangle inside the options.width x options.height frame, into
+// `tile` (reused when it already has the window's size): each pixel gets the colour render() gives
+// it, since a pixel's colour depends only on its own rays. Packets are cut from the window's top-left
+// corner; `progress` counts the window's packets. Throws cellrt::Error as render() does, and for a
+// window that is empty or not inside the frame.
+void render_window(const Scene& scene, const Accelerator& accel, const RenderOptions& options, const PixelRect& window,
+                   Image& tile, RenderStats* stats = nullptr);
+
+// One frame traced window by window (a distributed frame, tile by tile): the camera and every
+// worker's packet buffers are made once, so a frame cut into many windows costs no more set-up than
+// one (a workload's set-up reads every triangle for the AO rays' reach). Throws as render() does.
+// One thread at a time may call render_window; scene, accel and options must outlive the renderer.
+class FrameRenderer {
+public:
+    FrameRenderer(const Scene& scene, const Accelerator& accel, const RenderOptions& options);
+    ~FrameRenderer();
+    FrameRenderer(const FrameRenderer&) = delete;
+    FrameRenderer& operator=(const FrameRenderer&) = delete;
+
+    void render_window(const PixelRect& window, Image& tile, RenderStats* stats = nullptr);
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
 
 // The point a hit names and the triangle's geometric normal there, turned to face the side the ray
 // came from.

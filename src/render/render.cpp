@@ -121,37 +121,78 @@ Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& 
 
 void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& image,
             RenderStats* stats) {
-    const PinholeCamera camera(scene.camera, options.width, options.height);
-    const PacketGrid grid(options.width, options.height, options.packet);
-    if (image.width != options.width || image.height != options.height) image = Image(options.width, options.height);
+    render_window(scene, accel, options, PixelRect{0, 0, options.width, options.height}, image, stats);
+}
+
+void render_window(const Scene& scene, const Accelerator& accel, const RenderOptions& options, const PixelRect& window,
+                   Image& image, RenderStats* stats) {
+    FrameRenderer(scene, accel, options).render_window(window, image, stats);
+}
+
+struct FrameRenderer::State {
+    const Scene& scene;
+    const Accelerator& accel;
+    const RenderOptions& options;
+    PinholeCamera camera;
     ScheduleOptions schedule;
+    std::vector<PacketWork> work;
+};
+
+FrameRenderer::FrameRenderer(const Scene& scene, const Accelerator& accel, const RenderOptions& options)
+    : state_(std::make_unique<State>(State{scene, accel, options, PinholeCamera(scene.camera, options.width,
+                                                                                  options.height), {}, {}})) {
+    ScheduleOptions& schedule = state_->schedule;
     schedule.dispatch = options.dispatch;
     schedule.workers = options.threads;
     schedule.pin = options.pin;
     schedule.idle_spin = options.idle_spin;
     schedule.cancel = options.cancel;
     schedule.progress = options.progress;
+    static_cast<void>(PacketGrid(options.width, options.height, options.packet));  // refuses a bad packet edge
     // Sized here, so that workers never allocate: a thread's first allocation would create a malloc
     // arena of its own (page faults on every frame), and the hot path must not allocate.
     const auto packet_rays = static_cast<std::size_t>(options.packet) * static_cast<std::size_t>(options.packet);
-    std::vector<PacketWork> work;
-    work.reserve(worker_count(schedule));
-    for (unsigned w = 0; w < worker_count(schedule); ++w)
-        work.push_back({PacketWorkload(scene, camera, packet_rays, options.shading)});
+    const unsigned workers = worker_count(schedule);
+    state_->work.reserve(workers);
+    for (unsigned w = 0; w < workers; ++w)
+        state_->work.push_back({PacketWorkload(scene, state_->camera, packet_rays, options.shading)});
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+void FrameRenderer::render_window(const PixelRect& window, Image& image, RenderStats* stats) {
+    const Scene& scene = state_->scene;
+    const Accelerator& accel = state_->accel;
+    const RenderOptions& options = state_->options;
+    std::vector<PacketWork>& work = state_->work;
+    if (window.x0 < 0 || window.y0 < 0 || window.x1 > options.width || window.y1 > options.height ||
+        window.width() < 1 || window.height() < 1)
+        throw Error("window [" + std::to_string(window.x0) + ", " + std::to_string(window.x1) + ") x [" +
+                    std::to_string(window.y0) + ", " + std::to_string(window.y1) + ") is not inside the " +
+                    std::to_string(options.width) + "x" + std::to_string(options.height) + " frame");
+    const PacketGrid grid(window.width(), window.height(), options.packet);
+    if (image.width != window.width() || image.height != window.height())
+        image = Image(window.width(), window.height());
+    for (PacketWork& w : work) {
+        w.primary = w.secondary = TraversalCounters{};
+        w.secondary_ray_count = 0;
+    }
 
     Timer timer;
     std::vector<WorkerLoad> loads;
+    // The grid's packets are the window's; the rays are the frame's pixels under them.
     const bool complete = run_packets(
-        grid, schedule, image,
+        grid, state_->schedule, image,
         [&](unsigned w, const PixelRect& rect, std::span<Vec3> out) {
-            trace_packet(scene, accel, rect, options.count, work[w], out);
+            const PixelRect pixels{rect.x0 + window.x0, rect.y0 + window.y0, rect.x1 + window.x0, rect.y1 + window.y0};
+            trace_packet(scene, accel, pixels, options.count, work[w], out);
         },
         &loads);
     if (!complete) throw Error("render cancelled");
     if (stats) {
         *stats = RenderStats{};
         stats->seconds = timer.seconds();
-        stats->primary_rays = static_cast<std::uint64_t>(options.width) * options.height;
+        stats->primary_rays = static_cast<std::uint64_t>(window.pixels());
         stats->workers = std::move(loads);
         for (const PacketWork& w : work) {
             stats->primary += w.primary;

@@ -1,0 +1,35 @@
+// The plain cellrt program's cluster: this one process (cluster.hpp).
+#include "cluster.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <thread>
+#include <numeric>
+
+namespace cellrt::cli::cluster {
+
+void start(int&, char**&) {}
+int finish(int status) { return status; }
+int rank() { return 0; }
+int ranks() { return 1; }
+unsigned cores() { return std::max(1u, std::thread::hardware_concurrency()); }
+void print_error(const std::exception& e) { std::fprintf(stderr, "cellrt: error: %s\n", e.what()); }
+void add_render_options(CLI::App&) {}
+void add_sweep_options(CLI::App&) {}
+void together(const std::function<void()>& step, const std::string&) { step(); }
+Scene load_scene(const std::string& spec) { return cellrt::load_scene(spec); }
+
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
+            RenderStats& stats, nlohmann::json&) {
+    cellrt::render(scene, accel, options, frame, &stats);
+}
+
+std::vector<std::size_t> share(std::size_t count) {
+    std::vector<std::size_t> all(count);
+    std::iota(all.begin(), all.end(), std::size_t{0});
+    return all;
+}
+
+std::vector<std::string> gather(const std::string& mine) { return {mine}; }
+
+}  // namespace cellrt::cli::cluster

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# cellrt-mpi against one process (docs/DISTRIBUTED.md). Each configuration renders the frame, and a
+# 16 x 16 frame that costs the same loading, building and start-up; runs interleaved (one of each in
+# turn, REPS rounds). Reported: the median render time (rank 0's wall time for the frame) and the
+# frame's CPU time, the median CPU seconds of the whole command (all ranks and mpirun, from
+# getrusage) less those of the 16 x 16 run: on a machine shared with other work the wall time follows
+# the share of the cores a run gets, the CPU time what the run costs. Usage:
+#   bench/mpi_efficiency.sh SCENE [REPS] [SIZE]      (build/cellrt and build/cellrt-mpi must exist)
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${CELLRT_BUILD:-$root/build}"
+scene="$1"; reps="${2:-7}"; size="${3:-1920x1080}"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
+declare -A cmd=(
+  [plain_2threads]="$build/cellrt render $scene --threads 2"
+  [mpi1_2threads]="mpirun -np 1 --bind-to none $build/cellrt-mpi render $scene --threads 2"
+  [mpi2]="mpirun -np 2 $build/cellrt-mpi render $scene"
+  [mpi2_tile64]="mpirun -np 2 $build/cellrt-mpi render $scene --tile 64"
+)
+names=(plain_2threads mpi1_2threads mpi2 mpi2_tile64)
+for ((r = 0; r < reps; ++r)); do
+  for n in "${names[@]}"; do
+    for s in "$size" 16x16; do
+      /usr/bin/time -f "$n $s %U %S %e" -a -o "$work/time.txt" ${cmd[$n]} --size "$s" -o "$work/$n.$s.pfm" \
+        --stats "$work/$n.$s.$r.json" --overwrite > /dev/null
+    done
+    cmp -s "$work/$n.$size.pfm" "$work/plain_2threads.$size.pfm" || { echo "$n: the frame differs" >&2; exit 1; }
+  done
+done
+python3 - "$work" "$size" "${names[@]}" <<'PY'
+import json, statistics, sys, glob, os
+work, size, names = sys.argv[1], sys.argv[2], sys.argv[3:]
+cpu = {}
+for line in open(os.path.join(work, "time.txt")):
+    n, s, u, k, e = line.split()
+    cpu.setdefault((n, s), []).append(float(u) + float(k))
+med = statistics.median
+print(f"{'configuration':16} {'render s':>9} {'min':>6} {'max':>6} {'ratio':>6} {'frame CPU s':>12} {'ratio':>6}")
+base = None
+for n in names:
+    runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(work, f"{n}.{size}.*.json")))]
+    t = [j["render_seconds"] for j in runs]
+    frame_cpu = med(cpu[(n, size)]) - med(cpu[(n, "16x16")])
+    base = base or (med(t), frame_cpu)
+    print(f"{n:16} {med(t):9.3f} {min(t):6.3f} {max(t):6.3f} {med(t) / base[0]:6.3f} {frame_cpu:12.3f} {frame_cpu / base[1]:6.3f}")
+    if "ranks" in runs[-1]:
+        for k in runs[-1]["ranks"]:
+            print(f"    rank {k['rank']}: {k['threads']} threads, {k['tiles']} tiles, busy {k['busy_seconds']:.3f} s of "
+                  f"{k['seconds']:.3f} s, CPU {k['cpu_seconds']:.3f} s" +
+                  (f" (master {k['master_cpu_seconds']:.3f} s)" if "master_cpu_seconds" in k else ""))
+PY

@@ -1,0 +1,420 @@
+#include "distributed/tile_farm.hpp"
+
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "cellrt/timer.hpp"
+
+namespace cellrt::distributed {
+namespace {
+
+constexpr int kTagAssign = 1, kTagResult = 2;
+constexpr std::int32_t kNoTile = -1;
+
+// A returned tile: its pixels (traced), the cause (failed), or nothing (skipped: the rank had failed
+// before it reached the tile).
+enum class Outcome : std::int32_t { traced, failed, skipped };
+
+struct ResultHeader {
+    std::int32_t tile;
+    Outcome outcome;
+    double seconds;  // the rank's time tracing the tile
+};
+static_assert(sizeof(ResultHeader) == 16);
+
+// The longest cause a failed tile carries.
+constexpr std::size_t kMaxCause = 4096;
+
+// The frame in tiles of edge x edge pixels, row-major; tiles at the right and bottom are cut to it.
+struct TileGrid {
+    int width, height, edge, packet;
+
+    int columns() const { return (width + edge - 1) / edge; }
+    std::size_t count() const {
+        return static_cast<std::size_t>(columns()) * static_cast<std::size_t>((height + edge - 1) / edge);
+    }
+    PixelRect rect(std::size_t t) const {
+        const int x = static_cast<int>(t % static_cast<std::size_t>(columns())) * edge;
+        const int y = static_cast<int>(t / static_cast<std::size_t>(columns())) * edge;
+        return {x, y, std::min(x + edge, width), std::min(y + edge, height)};
+    }
+    std::size_t packets(std::size_t t) const {
+        const PixelRect r = rect(t);
+        return PacketGrid(r.width(), r.height(), packet).count();
+    }
+};
+
+void copy_into(Image& frame, const PixelRect& r, const Vec3* pixels) {
+    for (int y = r.y0; y < r.y1; ++y)
+        std::memcpy(&frame.at(r.x0, y), pixels + static_cast<std::size_t>(y - r.y0) * r.width(),
+                    sizeof(Vec3) * static_cast<std::size_t>(r.width()));
+}
+
+void add_tile(RankLoad& load, const RenderStats& s, std::size_t packets) {
+    ++load.tiles;
+    load.packets += packets;
+    load.secondary_rays += s.secondary_rays;
+    load.busy_seconds += s.seconds;
+    if (load.workers.size() < s.workers.size()) load.workers.resize(s.workers.size());
+    for (std::size_t w = 0; w < s.workers.size(); ++w) {
+        load.workers[w].packets += s.workers[w].packets;
+        load.workers[w].busy_seconds += s.workers[w].busy_seconds;
+    }
+}
+
+// The test suite's way to make a rank die or stop answering once it holds a tile (tests/mpi/,
+// docs/DISTRIBUTED.md): CELLRT_MPI_FAULT=kill:R or stall:R.
+void inject_fault(int rank) {
+    const char* fault = std::getenv("CELLRT_MPI_FAULT");
+    if (!fault) return;
+    const std::string f = fault;
+    const auto colon = f.find(':');
+    if (colon == std::string::npos || std::atoi(f.c_str() + colon + 1) != rank) return;
+    if (f.compare(0, colon, "kill") == 0) std::raise(SIGKILL);
+    if (f.compare(0, colon, "stall") == 0)
+        for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+}
+
+// Sends kept until MPI is done with their bytes.
+class Outbox {
+public:
+    void send(std::string bytes, int dest, int tag) {
+        sends_.push_back({std::move(bytes), MPI_REQUEST_NULL});
+        Send& s = sends_.back();
+        MPI_Isend(s.bytes.data(), static_cast<int>(s.bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &s.request);
+        for (int done = 1; done && !sends_.empty(); sends_.pop_front()) {
+            MPI_Test(&sends_.front().request, &done, MPI_STATUS_IGNORE);
+            if (!done) break;
+        }
+    }
+    void flush(const Session& session, const std::string& what) {
+        for (; !sends_.empty(); sends_.pop_front()) session.wait(sends_.front().request, what);
+    }
+
+private:
+    struct Send {
+        std::string bytes;
+        MPI_Request request;
+    };
+    std::deque<Send> sends_;
+};
+
+double cpu_seconds(clockid_t clock) {
+    timespec t{};
+    clock_gettime(clock, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+std::string int_bytes(std::int32_t v) { return std::string(reinterpret_cast<const char*>(&v), sizeof v); }
+
+RenderOptions tile_options(const RenderOptions& options) {
+    RenderOptions o = options;
+    o.threads = rank_threads(options.threads);
+    o.progress = nullptr;  // a tile's packets are not the frame's: rank 0 reports the frame's
+    return o;
+}
+
+// A rank other than 0: traces the tiles rank 0 hands it and returns each; a tile arrives for each
+// tile returned and `ahead` at the start, until rank 0 answers that none is left.
+RankLoad trace_for_master(const Session& session, const Scene& scene, const Accelerator& accel,
+                          const RenderOptions& options, const TileGrid& grid, int ahead,
+                          std::optional<std::string>& failure) {
+    const RenderOptions o = tile_options(options);
+    RankLoad load;
+    load.threads = o.threads;
+    Timer frame_timer;
+    const double cpu_start = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    std::deque<std::int32_t> queue;
+    int pending = ahead;  // answers rank 0 still owes this rank
+    std::int32_t incoming = kNoTile;
+    MPI_Request answer = MPI_REQUEST_NULL;
+    bool posted = false;
+    // Takes the answers that have come (with `wait`, waits for one first).
+    auto take = [&](bool wait) {
+        while (pending > 0) {
+            if (!posted) MPI_Irecv(&incoming, 1, MPI_INT32_T, 0, kTagAssign, MPI_COMM_WORLD, &answer);
+            posted = true;
+            int done = 1;
+            if (wait)
+                session.wait(answer, "rank 0's next tile");
+            else
+                MPI_Test(&answer, &done, MPI_STATUS_IGNORE);
+            if (!done) return;
+            wait = false;
+            posted = false;
+            --pending;
+            if (incoming != kNoTile) queue.push_back(incoming);
+        }
+    };
+    Outbox outbox;
+    Image tile;
+    std::unique_ptr<FrameRenderer> renderer;
+    try {
+        renderer = std::make_unique<FrameRenderer>(scene, accel, o);
+    } catch (const std::exception& e) {
+        failure = e.what();
+    }
+    bool first = true;
+    while (!queue.empty() || pending > 0) {
+        take(queue.empty());
+        if (queue.empty()) continue;
+        if (first) inject_fault(session.rank());
+        first = false;
+        const std::int32_t t = queue.front();
+        queue.pop_front();
+        std::string bytes(sizeof(ResultHeader), '\0');
+        ResultHeader header{t, Outcome::skipped, 0.0};
+        if (!failure) {
+            try {
+                RenderStats s;
+                renderer->render_window(grid.rect(static_cast<std::size_t>(t)), tile, &s);
+                add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
+                header.outcome = Outcome::traced;
+                header.seconds = s.seconds;
+                bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
+            } catch (const std::exception& e) {
+                failure = e.what();
+                header.outcome = Outcome::failed;
+                bytes.append(failure->substr(0, kMaxCause));
+            }
+        }
+        std::memcpy(bytes.data(), &header, sizeof header);
+        outbox.send(std::move(bytes), 0, kTagResult);
+        ++pending;
+    }
+    outbox.flush(session, "rank 0's receipt of the last tiles");
+    load.seconds = frame_timer.seconds();
+    load.cpu_seconds = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
+    return load;
+}
+
+// Rank 0: hands out tiles and gathers them into `frame`, while a thread of its own traces tiles too.
+RankLoad master(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
+                const TileGrid& grid, int ahead, Image& frame, std::optional<std::string>& failure) {
+    const auto ranks = static_cast<std::size_t>(session.size());
+    const std::size_t count = grid.count();
+    std::size_t all_packets = 0;
+    for (std::size_t t = 0; t < count; ++t) all_packets += grid.packets(t);
+    Timer frame_timer;
+    const double cpu_start = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    const double master_start = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+    std::atomic<std::size_t> next{0}, gathered{0};
+    std::atomic<bool> stop{false}, local_done{false};
+    auto claim = [&]() -> std::int32_t {
+        if (stop) return kNoTile;
+        const std::size_t t = next.fetch_add(1);
+        return t < count ? static_cast<std::int32_t>(t) : kNoTile;
+    };
+
+    // Rank 0's own tiles, claimed from the same counter; the thread never calls MPI.
+    const RenderOptions o = tile_options(options);
+    RankLoad load;
+    load.threads = o.threads;
+    std::thread local([&] {
+        Image tile;
+        std::unique_ptr<FrameRenderer> renderer;
+        try {
+            renderer = std::make_unique<FrameRenderer>(scene, accel, o);
+        } catch (const std::exception& e) {
+            failure = e.what();
+            stop = true;
+        }
+        for (std::int32_t t = claim(); t != kNoTile; t = claim()) {
+            try {
+                RenderStats s;
+                const PixelRect r = grid.rect(static_cast<std::size_t>(t));
+                renderer->render_window(r, tile, &s);
+                copy_into(frame, r, tile.pixels.data());
+                add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
+                gathered += grid.packets(static_cast<std::size_t>(t));
+            } catch (const std::exception& e) {
+                failure = e.what();
+                stop = true;
+            }
+        }
+        load.seconds = frame_timer.seconds();
+        local_done = true;
+    });
+
+    // The other ranks' tiles: `ahead` each at the start, then one per tile returned.
+    Outbox outbox;
+    std::vector<std::size_t> outstanding(ranks, 0);
+    std::vector<double> heard(ranks, 0.0), tile_time(ranks, 0.0);  // last result; a tile's mean time
+    // The master polls often enough to answer a rank before its queued tiles run out, and no more
+    // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md). The ranks' own tracing
+    // times set it, not the gaps between their results, which grow when a rank waits.
+    auto poll_interval = [&] {
+        double fastest = 0.0;
+        for (std::size_t r = 1; r < ranks; ++r)
+            if (tile_time[r] > 0.0 && (fastest == 0.0 || tile_time[r] < fastest)) fastest = tile_time[r];
+        if (fastest == 0.0) return kPollInterval;
+        const double seconds = std::clamp(fastest * (ahead - 1) / 4.0, 100e-6, 2e-3);
+        return std::chrono::microseconds(static_cast<long long>(seconds * 1e6));
+    };
+    std::size_t max_tile_pixels = 0;
+    for (std::size_t t = 0; t < count; ++t)
+        max_tile_pixels = std::max(max_tile_pixels, static_cast<std::size_t>(grid.rect(t).pixels()));
+    const std::size_t buffer_bytes = sizeof(ResultHeader) + std::max(max_tile_pixels * sizeof(Vec3), kMaxCause);
+    std::vector<std::string> buffers(ranks);
+    std::vector<MPI_Request> requests(ranks, MPI_REQUEST_NULL);
+    auto answer = [&](std::size_t r) {
+        const std::int32_t t = claim();
+        outbox.send(int_bytes(t), static_cast<int>(r), kTagAssign);
+        if (t != kNoTile) ++outstanding[r];
+    };
+    for (std::size_t r = 1; r < ranks; ++r) {
+        buffers[r].resize(buffer_bytes);
+        for (int a = 0; a < ahead; ++a) answer(r);
+        if (outstanding[r] > 0)
+            MPI_Irecv(buffers[r].data(), static_cast<int>(buffer_bytes), MPI_BYTE, static_cast<int>(r), kTagResult,
+                      MPI_COMM_WORLD, &requests[r]);
+    }
+    std::vector<int> indices(ranks);
+    const double timeout = static_cast<double>(session.timeout().count()) / 1e3;
+    std::size_t reported = 0;
+    for (;;) {
+        const bool remote = std::any_of(outstanding.begin(), outstanding.end(), [](std::size_t n) { return n > 0; });
+        if (!remote && local_done) break;
+        int completed = 0;
+        if (remote)
+            MPI_Testsome(static_cast<int>(ranks), requests.data(), &completed, indices.data(), MPI_STATUSES_IGNORE);
+        if (completed == MPI_UNDEFINED) completed = 0;
+        for (int i = 0; i < completed; ++i) {
+            const auto r = static_cast<std::size_t>(indices[static_cast<std::size_t>(i)]);
+            ResultHeader header;
+            std::memcpy(&header, buffers[r].data(), sizeof header);
+            --outstanding[r];
+            heard[r] = frame_timer.seconds();
+            if (header.outcome == Outcome::traced)
+                tile_time[r] = tile_time[r] > 0.0 ? 0.75 * tile_time[r] + 0.25 * header.seconds : header.seconds;
+            if (header.outcome == Outcome::traced) {
+                const auto t = static_cast<std::size_t>(header.tile);
+                copy_into(frame, grid.rect(t), reinterpret_cast<const Vec3*>(buffers[r].data() + sizeof header));
+                gathered += grid.packets(t);
+            } else if (header.outcome == Outcome::failed) {
+                stop = true;  // the rank reports its cause itself when the ranks agree
+            }
+            answer(r);
+            if (outstanding[r] > 0)
+                MPI_Irecv(buffers[r].data(), static_cast<int>(buffer_bytes), MPI_BYTE, static_cast<int>(r), kTagResult,
+                          MPI_COMM_WORLD, &requests[r]);
+        }
+        const double now = frame_timer.seconds();
+        for (std::size_t r = 1; r < ranks; ++r)
+            if (outstanding[r] > 0 && now - heard[r] > timeout)
+                session.abort("rank " + std::to_string(r) + " has returned no tile for " + session.timeout_text() +
+                              ", " + std::to_string(outstanding[r]) +
+                              " of its tiles outstanding (it stopped answering; --rank-timeout)");
+        if (options.progress && gathered != reported) options.progress(reported = gathered, all_packets);
+        if (completed == 0) std::this_thread::sleep_for(poll_interval());
+    }
+    local.join();
+    outbox.flush(session, "the last tiles' answers");
+    load.cpu_seconds = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
+    load.master_cpu_seconds = cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - master_start;
+    return load;
+}
+
+std::string load_bytes(const RankLoad& load) {
+    std::string out;
+    auto put = [&](const auto& v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    put(load.threads);
+    put(load.tiles);
+    put(load.packets);
+    put(load.secondary_rays);
+    put(load.busy_seconds);
+    put(load.seconds);
+    put(load.cpu_seconds);
+    put(load.master_cpu_seconds);
+    for (const WorkerLoad& w : load.workers) {
+        put(w.packets);
+        put(w.busy_seconds);
+    }
+    return out;
+}
+
+RankLoad parse_load(const std::string& bytes) {
+    RankLoad load;
+    std::size_t at = 0;
+    auto get = [&](auto& v) {
+        std::memcpy(&v, bytes.data() + at, sizeof v);
+        at += sizeof v;
+    };
+    get(load.threads);
+    get(load.tiles);
+    get(load.packets);
+    get(load.secondary_rays);
+    get(load.busy_seconds);
+    get(load.seconds);
+    get(load.cpu_seconds);
+    get(load.master_cpu_seconds);
+    while (at + sizeof(std::size_t) + sizeof(double) <= bytes.size()) {
+        WorkerLoad w;
+        get(w.packets);
+        get(w.busy_seconds);
+        load.workers.push_back(w);
+    }
+    return load;
+}
+
+}  // namespace
+
+unsigned rank_threads(unsigned threads) {
+    if (threads) return threads;
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return 0;
+    return std::clamp(static_cast<unsigned>(CPU_COUNT(&allowed)), 1u, kMaxWorkers);
+}
+
+void render_tiles(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
+                  const TileOptions& tiles, Image& frame, RenderStats* stats, std::vector<RankLoad>* loads) {
+    if (tiles.tile < 1 || tiles.tile > kMaxImageSide)
+        throw Error("tile edge " + std::to_string(tiles.tile) + " must lie in [1, " + std::to_string(kMaxImageSide) +
+                    "]");
+    if (tiles.ahead < 1 || tiles.ahead > kMaxAhead)
+        throw Error("tiles ahead " + std::to_string(tiles.ahead) + " must lie in [1, " + std::to_string(kMaxAhead) +
+                    "]");
+    check_image_size(options.width, options.height);
+    static_cast<void>(PacketGrid(options.width, options.height, options.packet));  // refuses a bad packet edge
+    const TileGrid grid{options.width, options.height, tiles.tile, options.packet};
+    std::optional<std::string> failure;
+    Timer timer;
+    RankLoad mine;
+    if (session.leader()) {
+        if (frame.width != options.width || frame.height != options.height)
+            frame = Image(options.width, options.height);
+        mine = master(session, scene, accel, options, grid, tiles.ahead, frame, failure);
+    } else {
+        mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, failure);
+    }
+    const double seconds = timer.seconds();
+    session.agree(failure, "the frame");
+    const std::vector<std::string> all = session.gather(load_bytes(mine), "the ranks' figures");
+    if (!session.leader()) return;
+    std::vector<RankLoad> gathered;
+    for (const std::string& b : all) gathered.push_back(parse_load(b));
+    if (stats) {
+        *stats = RenderStats{};
+        stats->seconds = seconds;
+        stats->primary_rays = static_cast<std::uint64_t>(options.width) * options.height;
+        for (const RankLoad& l : gathered) {
+            stats->secondary_rays += l.secondary_rays;
+            for (const WorkerLoad& w : l.workers) stats->workers.push_back({w.packets, w.busy_seconds, 0.0, l.seconds});
+        }
+    }
+    if (loads) *loads = std::move(gathered);
+}
+
+}  // namespace cellrt::distributed

@@ -1,0 +1,191 @@
+// cellrt-mpi under mpirun (docs/DISTRIBUTED.md): frames byte for byte those of the plain program for
+// 1, 2 and 3 ranks, every shading and several structures, tile and packet sizes; a cache study split
+// over ranks writes the plain program's results; a rank whose scene fails, a rank that dies, one that
+// stops answering and a bad option each end every rank with a non-zero status, one message naming the
+// rank and the cause, and no output file. Skipped where MPI was not found.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+namespace cellrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TempDir {
+    fs::path path = fs::temp_directory_path() /
+                    ("cellrt_mpi_" + std::to_string(::getpid()) + "_" +
+                     std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+    TempDir() { fs::create_directories(path); }
+    ~TempDir() { fs::remove_all(path); }
+};
+
+std::string read(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+struct Outcome {
+    int status;
+    std::string err;
+};
+
+// Runs `command` through the shell with a time-out of its own (a hang fails the test instead of
+// blocking it), its error output kept.
+Outcome shell(const std::string& command, const fs::path& dir) {
+    const fs::path err = dir / "stderr.txt";
+    const std::string line = "timeout 120 " + command + " > /dev/null 2> '" + err.string() + "'";
+    const int raw = std::system(line.c_str());
+    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : 128, read(err)};
+}
+
+// mpirun as CI runs it: as root, more ranks than cores.
+std::string mpirun(int ranks, const std::string& env = "") {
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    return std::string(CELLRT_MPIRUN) + " --allow-run-as-root --oversubscribe " + env + " -np " +
+           std::to_string(ranks) + " ";
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+class Distributed : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!std::string(CELLRT_MPI_SKIP).empty()) GTEST_SKIP() << CELLRT_MPI_SKIP;
+    }
+    TempDir dir;
+    const std::string mpi = CELLRT_MPI_CLI, plain = CELLRT_CLI;
+};
+
+constexpr const char* kScene = "'builtin:city?tris=3000&seed=3'";
+
+TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
+    struct Case {
+        const char* options;
+        int tile;
+    };
+    // Every shading, three structures, tiles cut at the frame's edges and packets cut at the tiles'.
+    const Case cases[] = {{"--accel kd --shading direct --packet 8", 24},
+                          {"--accel bih --shading ao --ao-samples 3 --packet 5", 16},
+                          {"--accel bvh --shading diffuse --packet 16", 40}};
+    for (const Case& c : cases) {
+        const std::string name = std::to_string(&c - cases);
+        const fs::path reference = dir.path / (name + "plain.pfm");
+        const std::string frame = std::string(kScene) + " --size 97x61 " + c.options;
+        ASSERT_EQ(shell(plain + " render " + frame + " -o " + reference.string(), dir.path).status, 0) << c.options;
+        for (int ranks : {1, 2, 3}) {
+            const fs::path out = dir.path / (name + "mpi" + std::to_string(ranks) + ".pfm");
+            const fs::path stats = dir.path / (name + "mpi" + std::to_string(ranks) + ".json");
+            // Three ranks also take the scene from rank 0's broadcast.
+            const std::string command = mpirun(ranks) + mpi + " render " + frame + " --tile " + std::to_string(c.tile) +
+                                        (ranks == 3 ? " --broadcast-scene" : "") + " -o " + out.string() +
+                                        " --stats " + stats.string();
+            const Outcome o = shell(command, dir.path);
+            ASSERT_EQ(o.status, 0) << command << "\n" << o.err;
+            EXPECT_EQ(read(out), read(reference)) << c.options << ", " << ranks << " ranks";
+            // Each rank's tiles and time; the tiles add up to the frame's.
+            const std::string report = read(stats);
+            EXPECT_EQ(count(report, "\"tiles\""), static_cast<std::size_t>(ranks)) << report;
+            EXPECT_NE(report.find("\"busy_seconds\""), std::string::npos);
+        }
+    }
+}
+
+TEST_F(Distributed, CacheStudySplitOverRanksWritesTheOneProcessResults) {
+    const std::string study = std::string(" cache-study ") + kScene +
+                              " --size 64x48 --structures kd bih --traversals branched --access sync --threads 1 -o ";
+    ASSERT_EQ(shell(plain + study + (dir.path / "plain").string(), dir.path).status, 0);
+    // Every column but the last, the run's wall time.
+    auto without_wall = [](const std::string& csv) {
+        std::istringstream in(csv);
+        std::string out, line;
+        while (std::getline(in, line)) out += line.substr(0, line.rfind(',')) + "\n";
+        return out;
+    };
+    const std::string csv = without_wall(read(dir.path / "plain" / "cache_study.csv"));
+    ASSERT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
+    for (int ranks : {2, 3}) {
+        const fs::path out = dir.path / ("mpi" + std::to_string(ranks));
+        const Outcome o = shell(mpirun(ranks) + mpi + study + out.string(), dir.path);
+        ASSERT_EQ(o.status, 0) << o.err;
+        EXPECT_EQ(without_wall(read(out / "cache_study.csv")), csv) << ranks << " ranks";
+        EXPECT_EQ(read(out / "best_layouts.md"), read(dir.path / "plain" / "best_layouts.md")) << ranks << " ranks";
+    }
+}
+
+// A failure: a non-zero status, one error line naming `rank` and holding `cause`, no output file.
+void expect_failure(const Outcome& o, const fs::path& out, const std::string& rank, const std::string& cause) {
+    EXPECT_NE(o.status, 0) << o.err;
+    EXPECT_EQ(count(o.err, "cellrt: error:"), 1u) << o.err;
+    EXPECT_NE(o.err.find("cellrt: error: " + rank), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find(cause), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(out));
+    for (const auto& entry : fs::directory_iterator(out.parent_path()))
+        EXPECT_EQ(entry.path().filename().string().find("frame"), std::string::npos) << entry.path();
+}
+
+TEST_F(Distributed, ARankWhoseSceneFailsEndsEveryRank) {
+    const fs::path out = dir.path / "frame.png";
+    // Rank 1 is given another scene (mpirun's MPMD form): it cannot load it.
+    const Outcome o = shell(mpirun(1) + mpi + " render " + kScene + " -o " + out.string() + " : -np 2 " + mpi +
+                                " render " + (dir.path / "missing.obj").string() + " -o " + out.string(),
+                            dir.path);
+    expect_failure(o, out, "rank 1: ", "missing.obj");
+    EXPECT_NE(o.err.find("(and 1 other rank)"), std::string::npos) << o.err;
+}
+
+TEST_F(Distributed, RanksWithDifferentScenesAreRefused) {
+    const fs::path out = dir.path / "frame.png";
+    const Outcome o = shell(mpirun(1) + mpi + " render " + kScene + " -o " + out.string() + " : -np 1 " + mpi +
+                                " render 'builtin:city?tris=3000&seed=4' -o " + out.string(),
+                            dir.path);
+    expect_failure(o, out, "rank 1: ", "differs from rank 0's");
+}
+
+TEST_F(Distributed, ABadOptionIsOneMessage) {
+    const fs::path out = dir.path / "frame.png";
+    expect_failure(shell(mpirun(3) + mpi + " render " + kScene + " --packet 0 -o " + out.string(), dir.path), out,
+                   "rank 0: ", "--packet 0 must lie in [1, 256]");
+    expect_failure(shell(mpirun(2) + mpi + " info " + kScene, dir.path), out, "rank 0: ", "info runs in one process");
+}
+
+TEST_F(Distributed, ARankThatDiesEndsTheJob) {
+    const fs::path out = dir.path / "frame.png";
+    const Outcome o = shell(mpirun(2, "-x CELLRT_MPI_FAULT=kill:1") + mpi + " render " + kScene +
+                                " --size 200x200 --tile 8 -o " + out.string(), dir.path);
+    EXPECT_NE(o.status, 0) << o.err;
+    // mpirun itself says which rank died, and how.
+    EXPECT_NE(o.err.find("rank 1"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("signal 9"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Distributed, ARankThatStopsAnsweringTimesOut) {
+    const fs::path out = dir.path / "frame.png";
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome o = shell(mpirun(3, "-x CELLRT_MPI_FAULT=stall:2") + mpi + " render " + kScene +
+                                " --size 200x200 --tile 8 --rank-timeout 2 -o " + out.string(), dir.path);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_NE(o.status, 0) << o.err;
+    EXPECT_EQ(count(o.err, "cellrt: error:"), 1u) << o.err;
+    EXPECT_NE(o.err.find("cellrt: error: rank 0: rank 2 has returned no tile for 2 s"), std::string::npos) << o.err;
+    EXPECT_LT(seconds, 30.0);
+    EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace cellrt
