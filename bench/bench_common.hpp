@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,23 @@ namespace cellrt::bench {
 inline double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// The process's peak resident memory (VmHWM) in bytes since the last reset_peak_memory(), or 0 where
+// /proc does not tell (not Linux).
+inline double peak_memory_bytes() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;  // in kB
+    return 0.0;
+}
+// Starts a new peak: Linux's clear_refs "5" sets VmHWM to the current resident size.
+inline void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+inline double resident_memory_bytes() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;
+    return 0.0;
 }
 
 // The scene a benchmark argument names: a builtin:... spec as it is, a shared scene's name as
