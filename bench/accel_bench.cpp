@@ -215,8 +215,8 @@ std::vector<Entry> build_configurations(const Scene& scene, const Options& o) {
             Pending& p = *it;
             try {
                 p.e.accel.reset();
-                const double before = bench::resident_memory_bytes();
                 bench::reset_peak_memory();
+                const double before = bench::resident_memory_bytes();
                 p.e.accel = make_accelerator(scene.triangles, p.cfg);
                 p.peaks.push_back(std::max(0.0, bench::peak_memory_bytes() - before));
                 const AccelStats st = p.e.accel->stats();

@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "cellrt/accel.hpp"
 
 namespace cellrt::bench {
@@ -27,8 +31,14 @@ inline double peak_memory_bytes() {
         if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;  // in kB
     return 0.0;
 }
-// Starts a new peak: Linux's clear_refs "5" sets VmHWM to the current resident size.
-inline void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+// Starts a new peak: freed heap memory goes back to the system first (glibc), then Linux's clear_refs
+// "5" sets VmHWM to the current resident size.
+inline void reset_peak_memory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+    std::ofstream("/proc/self/clear_refs") << "5";
+}
 inline double resident_memory_bytes() {
     std::ifstream status("/proc/self/status");
     for (std::string line; std::getline(status, line);)
