@@ -26,6 +26,7 @@
 #include <utility>
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -50,6 +51,10 @@ using namespace kdbuild;
 
 // Nodes with fewer references are built by one task.
 constexpr std::size_t kParallelMin = 2048;
+// Passes over large nodes in parallel builds (KdBuildParams::parallel_pass_min) work in blocks of
+// this many references whose results are combined in block order: the same counts and the same
+// reference order as one thread's.
+constexpr std::size_t kBlock = 16384;
 // The exact search keeps sorted events (W&H's O(N log N) sweep) in nodes this small; larger ones are
 // bounded by bins first.
 constexpr std::size_t kEventsBelow = 256;
@@ -362,16 +367,32 @@ private:
     // Per axis, how many reference boxes start and end in each bin: scratch.starts and .ends hold
     // axis a's histogram of bins[a].count bins at a * stride.
     template <class Bins>
-    static void histograms(const Work& w, const std::array<Bins, 3>& bins, std::size_t stride, Scratch& scratch) {
+    void histograms(const Work& w, const std::array<Bins, 3>& bins, std::size_t stride, Scratch& scratch) const {
+        auto count = [&](std::span<const Ref> refs, std::uint32_t* starts, std::uint32_t* ends) {
+            for (const Ref& r : refs)
+                for (int a = 0; a < 3; ++a) {
+                    ++starts[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.lo[a]))];
+                    ++ends[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.hi[a]))];
+                }
+        };
         scratch.starts.assign(3 * stride, 0u);
         scratch.ends.assign(3 * stride, 0u);
-        std::uint32_t* const starts = scratch.starts.data();
-        std::uint32_t* const ends = scratch.ends.data();
-        for (const Ref& r : w.refs)
-            for (int a = 0; a < 3; ++a) {
-                ++starts[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.lo[a]))];
-                ++ends[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.hi[a]))];
+        if (!parallel_pass(w)) return count(w.refs, scratch.starts.data(), scratch.ends.data());
+        const std::size_t blocks = (w.refs.size() + kBlock - 1) / kBlock;
+        std::vector<std::uint32_t> starts(blocks * 3 * stride, 0u), ends(blocks * 3 * stride, 0u);
+        tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+            count(block(w.refs, b), &starts[b * 3 * stride], &ends[b * 3 * stride]);
+        });
+        for (std::size_t b = 0; b < blocks; ++b)
+            for (std::size_t i = 0; i < 3 * stride; ++i) {
+                scratch.starts[i] += starts[b * 3 * stride + i];
+                scratch.ends[i] += ends[b * 3 * stride + i];
             }
+    }
+
+    bool parallel_pass(const Work& w) const { return p_.threads != 1 && !w.events_mode && w.refs.size() >= p_.parallel_pass_min; }
+    static std::span<Ref> block(std::span<Ref> refs, std::size_t b) {
+        return refs.subspan(b * kBlock, std::min(kBlock, refs.size() - b * kBlock));
     }
 
     // Shevtsov et al. section 3.2: min-max binning over the references' tight bounds; the candidates
@@ -561,15 +582,54 @@ private:
         const std::size_t n = w.refs.size();
         if (left_refs.size() < n) left_refs.resize(n);
         if (right_refs.size() < n) right_refs.resize(n);
+        if (!parallel_pass(w)) {
+            const Partition part = partition(w.refs, w.cell, s, left_refs.data(), right_refs.data());
+            left.refs = std::span(left_refs).first(part.left);
+            right.refs = std::span(right_refs).first(part.right);
+            left.bounds = part.left_bounds;
+            right.bounds = part.right_bounds;
+            return;
+        }
+        // Each block into its own part of two scratch arrays, then the parts back to back in block order.
+        const std::size_t blocks = (n + kBlock - 1) / kBlock;
+        std::vector<Ref> lscratch(n), rscratch(n);
+        std::vector<Partition> parts(blocks);
+        tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+            parts[b] = partition(block(w.refs, b), w.cell, s, &lscratch[b * kBlock], &rscratch[b * kBlock]);
+        });
+        std::size_t nl = 0, nr = 0;
+        Box3 lbounds, rbounds;
+        for (std::size_t b = 0; b < blocks; ++b) {
+            std::copy_n(&lscratch[b * kBlock], parts[b].left, &left_refs[nl]);
+            std::copy_n(&rscratch[b * kBlock], parts[b].right, &right_refs[nr]);
+            nl += parts[b].left;
+            nr += parts[b].right;
+            lbounds.extend(parts[b].left_bounds);
+            rbounds.extend(parts[b].right_bounds);
+        }
+        left.refs = std::span(left_refs).first(nl);
+        right.refs = std::span(right_refs).first(nr);
+        left.bounds = lbounds;
+        right.bounds = rbounds;
+    }
+
+    struct Partition {
+        std::size_t left = 0, right = 0;  // references written
+        Box3 left_bounds, right_bounds;
+    };
+
+    // split_refs() of `refs` into left_out[] and right_out[] (room for refs.size() each).
+    Partition partition(std::span<const Ref> refs, const Box3& cell, const Split& s, Ref* left_refs,
+                        Ref* right_refs) const {
         const int a = s.axis;
         std::size_t nl = 0, nr = 0;
         Box3 lbounds, rbounds;
-        for (const Ref& r : w.refs) {
+        for (const Ref& r : refs) {
             const bool planar_here = r.box.lo[a] == s.pos && r.box.hi[a] == s.pos;
             const bool goes_left = r.box.lo[a] < s.pos || (planar_here && s.planar_left);
             const bool goes_right = r.box.hi[a] > s.pos || (planar_here && !s.planar_left);
             if (goes_left && goes_right) {
-                const auto [lb, rb] = child_boxes(r.triangle, w.cell, s);
+                const auto [lb, rb] = child_boxes(r.triangle, cell, s);
                 if (!lb.is_empty()) left_refs[nl++] = {r.triangle, lb}, lbounds.extend(lb);
                 if (!rb.is_empty()) right_refs[nr++] = {r.triangle, rb}, rbounds.extend(rb);
             } else if (goes_left) {
@@ -580,10 +640,7 @@ private:
                 rbounds.extend(r.box);
             }
         }
-        left.refs = std::span(left_refs).first(nl);
-        right.refs = std::span(right_refs).first(nr);
-        left.bounds = lbounds;
-        right.bounds = rbounds;
+        return {nl, nr, lbounds, rbounds};
     }
 
     // W&H section 4.4: classify triangles by the split axis's events, clip the straddlers to both
