@@ -226,11 +226,17 @@ private:
         for (int a = 0; a < 3; ++a) {
             if (!binned[a]) continue;
             const Bin* bins = all_bins[a];
-            // Sweep from the right for the right sides' counts and extents, then from the left.
+            // Sweep from the right for the right sides' counts and extents, then from the left. An empty
+            // bin changes neither: its costs are its neighbour's, copied, and as a split it ties with the
+            // bin before it, which wins (small nodes have mostly empty bins).
             double right_cost[kSahBins];
             std::uint32_t count = 0;
             float right_lo = kInf;
             for (int k = kSahBins - 1; k > 0; --k) {
+                if (bins[k].count == 0 && k < kSahBins - 1) {
+                    right_cost[k] = right_cost[k + 1];
+                    continue;
+                }
                 count += bins[k].count;
                 right_lo = std::min(right_lo, bins[k].lo);
                 Box3 cell = r.box;
@@ -240,9 +246,10 @@ private:
             count = 0;
             float left_hi = -kInf;
             for (int k = 0; k < kSahBins - 1; ++k) {
+                if (bins[k].count == 0) continue;
                 count += bins[k].count;
                 left_hi = std::max(left_hi, bins[k].hi);
-                if (count == 0 || count == r.size()) continue;
+                if (count == r.size()) continue;
                 Box3 cell = r.box;
                 cell.hi[a] = std::min(cell.hi[a], left_hi);
                 const double cost = p_.traversal_cost + p_.intersection_cost * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
