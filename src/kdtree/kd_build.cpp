@@ -367,21 +367,23 @@ private:
     // Per axis, how many reference boxes start and end in each bin: scratch.starts and .ends hold
     // axis a's histogram of bins[a].count bins at a * stride.
     template <class Bins>
+    static void count(std::span<const Ref> refs, const std::array<Bins, 3>& bins, std::size_t stride,
+                      std::uint32_t* starts, std::uint32_t* ends) {
+        for (const Ref& r : refs)
+            for (int a = 0; a < 3; ++a) {
+                ++starts[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.lo[a]))];
+                ++ends[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.hi[a]))];
+            }
+    }
+    template <class Bins>
     void histograms(const Work& w, const std::array<Bins, 3>& bins, std::size_t stride, Scratch& scratch) const {
-        auto count = [&](std::span<const Ref> refs, std::uint32_t* starts, std::uint32_t* ends) {
-            for (const Ref& r : refs)
-                for (int a = 0; a < 3; ++a) {
-                    ++starts[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.lo[a]))];
-                    ++ends[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.hi[a]))];
-                }
-        };
         scratch.starts.assign(3 * stride, 0u);
         scratch.ends.assign(3 * stride, 0u);
-        if (!parallel_pass(w)) return count(w.refs, scratch.starts.data(), scratch.ends.data());
+        if (!parallel_pass(w)) return count(w.refs, bins, stride, scratch.starts.data(), scratch.ends.data());
         const std::size_t blocks = (w.refs.size() + kBlock - 1) / kBlock;
         std::vector<std::uint32_t> starts(blocks * 3 * stride, 0u), ends(blocks * 3 * stride, 0u);
         tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
-            count(block(w.refs, b), &starts[b * 3 * stride], &ends[b * 3 * stride]);
+            count(block(w.refs, b), bins, stride, &starts[b * 3 * stride], &ends[b * 3 * stride]);
         });
         for (std::size_t b = 0; b < blocks; ++b)
             for (std::size_t i = 0; i < 3 * stride; ++i) {
@@ -579,50 +581,44 @@ private:
     // it by `planar_left`, and a straddler's clipped parts to the sides they reach (W&H section 4.4).
     void split_refs(const Work& w, const Split& s, Work& left, Work& right, std::vector<Ref>& left_refs,
                     std::vector<Ref>& right_refs) const {
+        // Reserved, not resized: a buffer's pages become resident only as far as references fill them.
         const std::size_t n = w.refs.size();
-        if (left_refs.size() < n) left_refs.resize(n);
-        if (right_refs.size() < n) right_refs.resize(n);
-        if (!parallel_pass(w)) {
-            const Partition part = partition(w.refs, w.cell, s, left_refs.data(), right_refs.data());
-            left.refs = std::span(left_refs).first(part.left);
-            right.refs = std::span(right_refs).first(part.right);
-            left.bounds = part.left_bounds;
-            right.bounds = part.right_bounds;
-            return;
-        }
-        // Each block into its own part of two scratch arrays, then the parts back to back in block order.
-        const std::size_t blocks = (n + kBlock - 1) / kBlock;
-        std::vector<Ref> lscratch(n), rscratch(n);
-        std::vector<Partition> parts(blocks);
-        tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
-            parts[b] = partition(block(w.refs, b), w.cell, s, &lscratch[b * kBlock], &rscratch[b * kBlock]);
-        });
-        std::size_t nl = 0, nr = 0;
+        left_refs.clear();
+        right_refs.clear();
+        left_refs.reserve(n);
+        right_refs.reserve(n);
         Box3 lbounds, rbounds;
-        for (std::size_t b = 0; b < blocks; ++b) {
-            std::copy_n(&lscratch[b * kBlock], parts[b].left, &left_refs[nl]);
-            std::copy_n(&rscratch[b * kBlock], parts[b].right, &right_refs[nr]);
-            nl += parts[b].left;
-            nr += parts[b].right;
-            lbounds.extend(parts[b].left_bounds);
-            rbounds.extend(parts[b].right_bounds);
+        if (!parallel_pass(w)) {
+            const auto [lb, rb] = partition(w.refs, w.cell, s, left_refs, right_refs);
+            lbounds = lb, rbounds = rb;
+        } else {
+            // Each block into lists of its own, then the lists back to back in block order.
+            const std::size_t blocks = (n + kBlock - 1) / kBlock;
+            std::vector<std::vector<Ref>> lparts(blocks), rparts(blocks);
+            std::vector<std::pair<Box3, Box3>> bounds(blocks);
+            tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+                const std::span<const Ref> refs = block(w.refs, b);
+                lparts[b].reserve(refs.size());
+                rparts[b].reserve(refs.size());
+                bounds[b] = partition(refs, w.cell, s, lparts[b], rparts[b]);
+            });
+            for (std::size_t b = 0; b < blocks; ++b) {
+                left_refs.insert(left_refs.end(), lparts[b].begin(), lparts[b].end());
+                right_refs.insert(right_refs.end(), rparts[b].begin(), rparts[b].end());
+                lbounds.extend(bounds[b].first);
+                rbounds.extend(bounds[b].second);
+            }
         }
-        left.refs = std::span(left_refs).first(nl);
-        right.refs = std::span(right_refs).first(nr);
+        left.refs = left_refs;
+        right.refs = right_refs;
         left.bounds = lbounds;
         right.bounds = rbounds;
     }
 
-    struct Partition {
-        std::size_t left = 0, right = 0;  // references written
-        Box3 left_bounds, right_bounds;
-    };
-
-    // split_refs() of `refs` into left_out[] and right_out[] (room for refs.size() each).
-    Partition partition(std::span<const Ref> refs, const Box3& cell, const Split& s, Ref* left_refs,
-                        Ref* right_refs) const {
+    // split_refs() of `refs`, appended to the two lists; returns the bounds of what each received.
+    std::pair<Box3, Box3> partition(std::span<const Ref> refs, const Box3& cell, const Split& s,
+                                    std::vector<Ref>& left_refs, std::vector<Ref>& right_refs) const {
         const int a = s.axis;
-        std::size_t nl = 0, nr = 0;
         Box3 lbounds, rbounds;
         for (const Ref& r : refs) {
             const bool planar_here = r.box.lo[a] == s.pos && r.box.hi[a] == s.pos;
@@ -630,17 +626,17 @@ private:
             const bool goes_right = r.box.hi[a] > s.pos || (planar_here && !s.planar_left);
             if (goes_left && goes_right) {
                 const auto [lb, rb] = child_boxes(r.triangle, cell, s);
-                if (!lb.is_empty()) left_refs[nl++] = {r.triangle, lb}, lbounds.extend(lb);
-                if (!rb.is_empty()) right_refs[nr++] = {r.triangle, rb}, rbounds.extend(rb);
+                if (!lb.is_empty()) left_refs.push_back({r.triangle, lb}), lbounds.extend(lb);
+                if (!rb.is_empty()) right_refs.push_back({r.triangle, rb}), rbounds.extend(rb);
             } else if (goes_left) {
-                left_refs[nl++] = r;
+                left_refs.push_back(r);
                 lbounds.extend(r.box);
             } else {
-                right_refs[nr++] = r;
+                right_refs.push_back(r);
                 rbounds.extend(r.box);
             }
         }
-        return {nl, nr, lbounds, rbounds};
+        return {lbounds, rbounds};
     }
 
     // W&H section 4.4: classify triangles by the split axis's events, clip the straddlers to both
