@@ -55,6 +55,8 @@ constexpr std::size_t kParallelMin = 2048;
 // this many references whose results are combined in block order: the same counts and the same
 // reference order as one thread's.
 constexpr std::size_t kBlock = 16384;
+// Nodes with at least this many references give their children buffers of their own (sequential()).
+constexpr std::size_t kOwnedMin = 65536;
 // The exact search keeps sorted events (W&H's O(N log N) sweep) in nodes this small; larger ones are
 // bounded by bins first.
 constexpr std::size_t kEventsBelow = 256;
@@ -215,7 +217,11 @@ private:
         Work left, right;
         auto& refs = scratch.children[w.depth + 1];
         auto& events = scratch.children_events[w.depth + 1];
-        split(std::move(w), d.split, left, right, {refs[0], refs[1], events[0], events[1]}, scratch);
+        // A large node's children own their references, freed once they are split in turn: a
+        // per-depth buffer would keep the largest node of its depth for the rest of the build.
+        const bool owned = !w.events_mode && w.size() >= kOwnedMin;
+        split(std::move(w), d.split, left, right,
+              {owned ? left.owned : refs[0], owned ? right.owned : refs[1], events[0], events[1]}, scratch);
         const double left_cost = sequential(std::move(left), out, pair, scratch);
         const double right_cost = sequential(std::move(right), out, pair + 1, scratch);
         const double cost = split_cost(cell, d.split, left_cost, right_cost);
