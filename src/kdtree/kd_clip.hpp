@@ -86,13 +86,13 @@ public:
     // few roundings in double, far less than the float step between box and plane unless coordinates
     // differ by many orders of magnitude; a cut skipped there would only leave the box a little larger,
     // still conservative.)
-    void clip_to_slab(int a, const Box3& cell, const Box3& inside) {
+    [[gnu::always_inline]] void clip_to_slab(int a, const Box3& cell, const Box3& inside) {
         if (!(inside.lo[a] > cell.lo[a])) clip<true>(a, cell.lo[a]);
         if (!(inside.hi[a] < cell.hi[a])) clip<false>(a, cell.hi[a]);
     }
 
     // Bounds rounded outward and cut to `cell`; empty when nothing is left.
-    Box3 bounds(const Box3& cell) const {
+    [[gnu::always_inline]] Box3 bounds(const Box3& cell) const {
         if (n_ == 0) return Box3::empty();
         const P* v = buffers_[current_];
         double lo[3], hi[3];

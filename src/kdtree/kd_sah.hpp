@@ -88,7 +88,7 @@ public:
 
     // Whether a candidate with this estimate may be cheaper than the best.
     bool may_improve(double estimate) const { return estimate < bound_; }
-    void offer(int axis, float pos, std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr,
+    [[gnu::always_inline]] void offer(int axis, float pos, std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr,
                bool planar_left) {
         if (!may_improve(sah_.estimate(areas, nl, nr))) return;
         const double cost = sah_.split(areas, nl, nr);
