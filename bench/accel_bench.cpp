@@ -7,7 +7,8 @@
 // hit (any hit); `diffuse`, one cosine-weighted bounce per hit (closest hit). The hits are found by an
 // exact structure, so every configuration traces the very same rays. `random` rays are incoherent:
 // origins in the scene's box, directions uniform. The second kind is reported in the shadow_* fields.
-// Each configuration is built `--builds` times (median reported); then, after a warm-up pass each,
+// Each configuration is built `--builds` times, the configurations in turn (median reported, with the
+// build's peak memory and the tree's SAH cost); then, after a warm-up pass each,
 // the configurations are traced in turn, `--repeats` rounds (median per ray kind), single-threaded
 // unless `--threads` says otherwise.
 #include <CLI/CLI.hpp>
@@ -108,7 +109,9 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--ao-samples", o.ao_samples, "AO rays per primary hit (--rays ao)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxAoSamples));
-    app.add_option("--clock", o.clock, "Time tracing by the wall clock or this thread's CPU clock")
+    app.add_option("--clock", o.clock,
+                   "Time by the wall clock, or by CPU time: this thread's for tracing, the process's (all threads) "
+                   "for builds")
         ->capture_default_str()
         ->check(CLI::IsMember({"wall", "cpu"}));
     try {
@@ -174,6 +177,8 @@ struct Result {
     std::string config;
     bool embree = false;
     double build_s = 0, memory_mib = 0, primary_s = 0, shadow_s = 0;
+    double build_peak_mib = 0;  // the build's peak resident memory above what the process held before it
+    double sah_cost = 0;        // the tree's report; 0 where the structure has none
     std::size_t differing = 0, differing_secondary = 0;  // answers that differ from the exact ones
     TraversalCounters primary_work, shadow_work;
 };
@@ -185,30 +190,51 @@ struct Entry {
     std::vector<double> primary_s, shadow_s;
 };
 
-// Every configuration built --builds times (median build time); one that this binary or processor
+// Every configuration built --builds times, in turn (A B C, A B C, ...: a slow spell of a shared machine
+// falls on all of them alike), median build time and peak memory; one that this binary or processor
 // cannot build is skipped with a message.
 std::vector<Entry> build_configurations(const Scene& scene, const Options& o) {
-    std::vector<Entry> entries;
+    struct Pending {
+        Entry e;
+        AccelConfig cfg;
+        std::vector<double> times, peaks;
+    };
+    std::vector<Pending> pending;
     for (const std::string& text : o.configs) {
         AccelConfig cfg = parse_accel_config(text);
         cfg.threads = o.threads;
         if (!bench::built_in(cfg.kind)) continue;
-        Entry e;
-        e.r.config = text;
-        e.r.embree = cfg.kind == "embree";
-        std::vector<double> build_times;
-        try {
-            for (int b = 0; b < o.builds; ++b) {
-                e.accel.reset();
-                e.accel = make_accelerator(scene.triangles, cfg);
-                build_times.push_back(e.accel->stats().build_seconds);
+        Pending p;
+        p.e.r.config = text;
+        p.e.r.embree = cfg.kind == "embree";
+        p.cfg = cfg;
+        pending.push_back(std::move(p));
+    }
+    for (int b = 0; b < o.builds; ++b)
+        for (auto it = pending.begin(); it != pending.end();) {
+            Pending& p = *it;
+            try {
+                p.e.accel.reset();
+                bench::reset_peak_memory();
+                const double before = bench::resident_memory_bytes();
+                p.e.accel = make_accelerator(scene.triangles, p.cfg);
+                p.peaks.push_back(std::max(0.0, bench::peak_memory_bytes() - before));
+                const AccelStats st = p.e.accel->stats();
+                p.times.push_back(o.clock == "cpu" ? st.build_cpu_seconds : st.build_seconds);
+                ++it;
+            } catch (const Error& err) {  // e.g. a packet width this processor lacks
+                std::fprintf(stderr, "skipping %s: %s\n", p.e.r.config.c_str(), err.what());
+                it = pending.erase(it);
             }
-        } catch (const Error& err) {  // e.g. a packet width this processor lacks
-            std::fprintf(stderr, "skipping %s: %s\n", text.c_str(), err.what());
-            continue;
         }
-        e.r.build_s = median(build_times);
-        e.r.memory_mib = static_cast<double>(e.accel->stats().memory_bytes) / (1024.0 * 1024.0);
+    std::vector<Entry> entries;
+    for (Pending& p : pending) {
+        Entry& e = p.e;
+        e.r.build_s = median(p.times);
+        e.r.build_peak_mib = median(p.peaks) / (1024.0 * 1024.0);
+        const AccelStats st = e.accel->stats();
+        e.r.memory_mib = static_cast<double>(st.memory_bytes) / (1024.0 * 1024.0);
+        if (st.tree) e.r.sah_cost = st.tree->sah_cost;
         entries.push_back(std::move(e));
     }
     return entries;
@@ -282,9 +308,9 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
         if (!best || total(r) > total(*best)) best = &r;
     }
     const char* second = to_string(rays.secondary_kind);
-    std::printf("| config | build ms | build ÷ Embree | memory MiB | primary Mrays/s | %s Mrays/s | "
-                "total Mrays/s | × Embree 1 | × Embree best | answers ≠ exact | nodes/leaves/tris per primary "
-                "ray | per %s ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    std::printf("| config | build ms | build ÷ Embree | build peak MiB | memory MiB | SAH cost | primary Mrays/s | "
+                "%s Mrays/s | total Mrays/s | × Embree 1 | × Embree best | answers ≠ exact | nodes/leaves/tris per "
+                "primary ray | per %s ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                 second, second);
     auto ratio = [](const Result* y, double value, double of_y) {
         if (!y) return std::string("–");
@@ -294,10 +320,12 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
     };
     for (const Result& r : results) {
         const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
-        std::printf("| %s | %.1f | %s | %.2f | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | "
+        char sah[32] = "–";
+        if (r.sah_cost > 0) std::snprintf(sah, sizeof sah, "%.2f", r.sah_cost);
+        std::printf("| %s | %.1f | %s | %.1f | %.2f | %s | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | "
                     "%.1f / %.1f / %.1f |\n",
                     r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
-                    r.memory_mib, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
+                    r.build_peak_mib, r.memory_mib, sah, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
                     ratio(single, total(r), single ? total(*single) : 1).c_str(),
                     ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing + r.differing_secondary,
                     per_ray(pw.nodes, pw),
@@ -315,7 +343,8 @@ nlohmann::json json_row(const Scene& scene, int width, int height, const Options
             {"shadow_kind", to_string(rays.secondary_kind)},
             {"ao_samples", o.ray_kind == "ao" ? o.ao_samples : 0},
             {"width", width}, {"height", height}, {"triangles", scene.triangles.size()},
-            {"build_seconds", r.build_s}, {"memory_mib", r.memory_mib},
+            {"build_seconds", r.build_s}, {"clock", o.clock}, {"build_threads", o.threads},
+            {"build_peak_mib", r.build_peak_mib}, {"memory_mib", r.memory_mib}, {"sah_cost", r.sah_cost},
             // The second kind of rays (shadow, AO, bounce or random) keeps the shadow_* names.
             {"primary_rays", rays.primary.size()}, {"shadow_rays", rays.secondary.size()},
             {"primary_seconds", r.primary_s}, {"shadow_seconds", r.shadow_s},

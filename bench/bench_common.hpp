@@ -4,9 +4,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "cellrt/accel.hpp"
 
@@ -16,6 +21,29 @@ namespace cellrt::bench {
 inline double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// The process's peak resident memory (VmHWM) in bytes since the last reset_peak_memory(), or 0 where
+// /proc does not tell (not Linux).
+inline double peak_memory_bytes() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;  // in kB
+    return 0.0;
+}
+// Starts a new peak: freed heap memory goes back to the system first (glibc), then Linux's clear_refs
+// "5" sets VmHWM to the current resident size.
+inline void reset_peak_memory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+    std::ofstream("/proc/self/clear_refs") << "5";
+}
+inline double resident_memory_bytes() {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+        if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;
+    return 0.0;
 }
 
 // The scene a benchmark argument names: a builtin:... spec as it is, a shared scene's name as

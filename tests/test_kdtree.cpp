@@ -77,14 +77,18 @@ TEST(KdTree, SameTreeBytesAtAnyThreadCount) {
     detail::KdBuildParams p;
     p.threads = 1;
     const detail::KdTree one = detail::build_kdtree(scene.triangles, p);
-    for (unsigned threads : {2u, 4u, 0u}) {
-        p.threads = threads;
-        const detail::KdTree many = detail::build_kdtree(scene.triangles, p);
-        ASSERT_EQ(one.nodes.size(), many.nodes.size()) << threads << " threads";
-        ASSERT_EQ(one.indices, many.indices) << threads << " threads";
-        EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::KdNode)), 0)
-            << threads << " threads";
-    }
+    // Also with the parallel binning and partition of large nodes brought down to this scene's top nodes.
+    for (const std::size_t pass_min : {p.parallel_pass_min, std::size_t{4096}})
+        for (unsigned threads : {2u, 4u, 0u}) {
+            p.threads = threads;
+            p.parallel_pass_min = pass_min;
+            const detail::KdTree many = detail::build_kdtree(scene.triangles, p);
+            const std::string what = std::to_string(threads) + " threads, parallel passes from " + std::to_string(pass_min);
+            ASSERT_EQ(one.nodes.size(), many.nodes.size()) << what;
+            ASSERT_EQ(one.indices, many.indices) << what;
+            EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::KdNode)), 0)
+                << what;
+        }
 }
 
 TEST(KdTree, ReportsItsBuild) {

@@ -71,6 +71,7 @@ struct AccelStats {
     std::string traversal;        // the single-ray kernel, "packet" (SIMD packets), or Embree's
     int simd_lanes = 0;           // rays a SIMD packet traces at once; 0: single rays
     double build_seconds = 0.0;
+    double build_cpu_seconds = 0.0;  // the process's CPU time over the build, all threads together
     std::size_t memory_bytes = 0;
     std::size_t triangles = 0;
     std::optional<TreeReport> tree;  // kd-tree and BIH

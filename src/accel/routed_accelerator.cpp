@@ -25,6 +25,7 @@ public:
         s.traversal = "auto";
         s.simd_lanes = c.simd_lanes;
         s.build_seconds = c.build_seconds + i.build_seconds;
+        s.build_cpu_seconds = c.build_cpu_seconds + i.build_cpu_seconds;
         s.memory_bytes = c.memory_bytes + i.memory_bytes;
         s.triangles = c.triangles;
         s.settings = {{"packets", packets_}, {"coherence", param_number(threshold_)}};

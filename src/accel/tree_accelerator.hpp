@@ -30,6 +30,7 @@ public:
         s.traversal = packets_ ? "packet" : traversal_name_;
         s.simd_lanes = lanes_;
         s.build_seconds = build_seconds_;
+        s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = structure_.memory_bytes();
         s.triangles = structure_.triangle_array().size();
         s.tree = structure_.report();
@@ -53,6 +54,7 @@ private:
         Timer timer;
         S s(triangles, config);
         build_seconds_ = timer.seconds();
+        build_cpu_seconds_ = timer.cpu_seconds();
         return s;
     }
 
@@ -73,7 +75,8 @@ private:
     typename S::Traversal traversal_;
     const TreePacketKernels<typename S::Traits>* packets_;
     int lanes_;
-    double build_seconds_ = 0.0;  // before structure_: build() sets it while structure_ is initialised
+    // Before structure_: build() sets them while structure_ is initialised.
+    double build_seconds_ = 0.0, build_cpu_seconds_ = 0.0;
     S structure_;
 };
 

@@ -17,8 +17,10 @@
 // no split is cheaper than testing its triangles.
 //
 // Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
-// known in advance. Large ranges are built as parallel tasks (kernel/subtree.hpp keeps the layout
-// independent of the thread count).
+// known in advance. The builder reorders records of box and triangle index in place, read in order
+// (no indirection): per node one pass bins all three axes, one partitions, and one bounds the two
+// children's centres and boxes, which their own decisions then need. Large ranges are built as
+// parallel tasks (kernel/subtree.hpp keeps the layout independent of the thread count).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -54,27 +56,33 @@ struct Range {
     std::uint32_t begin = 0, end = 0;
     Box3 box;   // the node's clip box: where its triangles may lie
     Box3 grid;  // the global heuristic's candidate cell
+    Box3 centres, objects;  // bounds of the range's triangle centres and boxes
     int depth = 0;
     std::uint32_t size() const { return end - begin; }
+};
+
+// A triangle as the builder moves it: its box and its scene index.
+struct Item {
+    Box3 box;
+    std::uint32_t triangle;
+    Vec3 centre() const { return box.center(); }
 };
 
 class BihBuilder {
 public:
     BihBuilder(std::span<const Triangle> tris, const BihBuildParams& p) : tris_(tris), p_(p) {
-        boxes_.reserve(tris.size());
-        centres_.reserve(tris.size());
-        for (const Triangle& t : tris) {
-            boxes_.push_back(t.bounds());
-            centres_.push_back(boxes_.back().center());
-        }
-        order_.resize(tris.size());
-        for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+        items_.resize(tris.size());
+        for (std::uint32_t i = 0; i < items_.size(); ++i) items_[i] = {tris[i].bounds(), i};
     }
 
     BihTree build() {
         BihTree tree;
-        Range root{0, static_cast<std::uint32_t>(tris_.size()), {}, {}, 0};
-        for (const Box3& b : boxes_) root.box.extend(b);
+        Range root{0, static_cast<std::uint32_t>(tris_.size()), {}, {}, {}, {}, 0};
+        for (const Item& it : items_) {
+            root.objects.extend(it.box);
+            root.centres.extend(it.centre());
+        }
+        root.box = root.objects;
         if (tris_.empty()) root.box = Box3{Vec3(0.f), Vec3(0.f)};
         root.grid = root.box;
         tree.bounds = root.box;
@@ -90,8 +98,11 @@ public:
         std::vector<std::uint32_t> no_indices;
         flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
         tree.triangles.reserve(tris_.size());
-        for (const std::uint32_t i : order_) tree.triangles.push_back(tris_[i]);
-        tree.prims = std::move(order_);
+        tree.prims.reserve(tris_.size());
+        for (const Item& it : items_) {
+            tree.triangles.push_back(tris_[it.triangle]);
+            tree.prims.push_back(it.triangle);
+        }
         return tree;
     }
 
@@ -108,12 +119,8 @@ private:
     Decision decide(Range r) {
         Decision d;
         if (r.size() <= static_cast<std::uint32_t>(p_.leaf_size) || r.depth >= p_.max_depth) return d;
-        Box3 centres, objects;
-        for (std::uint32_t i = r.begin; i < r.end; ++i) {
-            centres.extend(centres_[order_[i]]);
-            objects.extend(boxes_[order_[i]]);
-        }
-        if (p_.split == BihSplit::sah) return decide_sah(r, centres, objects);
+        const Box3 &centres = r.centres, &objects = r.objects;
+        if (p_.split == BihSplit::sah) return decide_sah(r);
         for (;;) {
             const int a = longest_axis(r.grid);
             const float split = 0.5f * (r.grid.lo[a] + r.grid.hi[a]);
@@ -131,7 +138,7 @@ private:
                 r.grid.lo[a] = split;
                 continue;
             }
-            Decision d = split_at(r, a, [&](std::uint32_t t) { return centres_[t][a] <= split; });
+            Decision d = split_at(r, a, [&](const Item& t) { return t.centre()[a] <= split; });
             d.left.grid.hi[a] = split;
             d.right.grid.lo[a] = split;
             return d;
@@ -139,30 +146,37 @@ private:
     }
 
     // Partitions the range in place into the triangles for which `goes_left` holds and the rest (both
-    // sides non-empty), with the clip planes at the two sides' extents on `a`.
+    // sides non-empty), with the clip planes at the two sides' extents on `a`, and bounds each side.
     template <class GoesLeft>
     Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
-        const auto mid_it = std::partition(order_.begin() + r.begin, order_.begin() + r.end, goes_left);
-        const auto mid = static_cast<std::uint32_t>(mid_it - order_.begin());
+        const auto mid_it = std::partition(items_.begin() + r.begin, items_.begin() + r.end, goes_left);
+        const auto mid = static_cast<std::uint32_t>(mid_it - items_.begin());
         Decision d;
         d.kind = Kind::split;
         d.axis = a;
-        d.left_clip = -kInf;
-        d.right_clip = kInf;
-        for (std::uint32_t i = r.begin; i < mid; ++i) d.left_clip = std::max(d.left_clip, boxes_[order_[i]].hi[a]);
-        for (std::uint32_t i = mid; i < r.end; ++i) d.right_clip = std::min(d.right_clip, boxes_[order_[i]].lo[a]);
         d.left = d.right = r;
         d.left.end = mid;
         d.right.begin = mid;
+        for (Range* side : {&d.left, &d.right}) {
+            Box3 centres, objects;
+            for (std::uint32_t i = side->begin; i < side->end; ++i) {
+                objects.extend(items_[i].box);
+                centres.extend(items_[i].centre());
+            }
+            side->centres = centres;
+            side->objects = objects;
+        }
+        d.left_clip = d.left.objects.hi[a];
+        d.right_clip = d.right.objects.lo[a];
         d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
         d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
         d.left.depth = d.right.depth = r.depth + 1;
         return d;
     }
 
-    // The SAH split (see the top of this file). `centres` and `objects` bound the range's triangle
-    // centres and boxes.
-    Decision decide_sah(const Range& r, const Box3& centres, const Box3& objects) {
+    // The SAH split (see the top of this file).
+    Decision decide_sah(const Range& r) {
+        const Box3 &centres = r.centres, &objects = r.objects;
         // Empty space first: the side of the cell with the largest empty fraction, beyond empty_cut.
         int cut_axis = -1;
         bool cut_high = false;
@@ -188,23 +202,41 @@ private:
         const double cell_measure = measure(r.box);
         double best_cost = kInf;
         int best_axis = -1, best_bin = 0;
+        // One pass bins all three axes; an axis with no extent, or too little to bin, is binned at
+        // scale 0 (all in bin 0) and skipped below.
+        bool binned[3];
+        float scales[3];
         for (int a = 0; a < 3; ++a) {
-            const float lo = centres.lo[a], extent = centres.hi[a] - lo;
-            const float scale = kSahBins / extent;
-            if (!(extent > 0.f) || !std::isfinite(scale)) continue;  // no extent, or too little to bin
-            Bin bins[kSahBins];
-            for (std::uint32_t i = r.begin; i < r.end; ++i) {
-                const std::uint32_t t = order_[i];
-                Bin& b = bins[bin_of(centres_[t][a], lo, scale)];
+            const float extent = centres.hi[a] - centres.lo[a];
+            scales[a] = kSahBins / extent;
+            binned[a] = extent > 0.f && std::isfinite(scales[a]);
+            if (!binned[a]) scales[a] = 0.f;
+        }
+        Bin all_bins[3][kSahBins];
+        for (std::uint32_t i = r.begin; i < r.end; ++i) {
+            const Item& t = items_[i];
+            const Vec3 c = t.centre();
+            for (int a = 0; a < 3; ++a) {
+                Bin& b = all_bins[a][bin_of(c[a], centres.lo[a], scales[a])];
                 ++b.count;
-                b.hi = std::max(b.hi, boxes_[t].hi[a]);
-                b.lo = std::min(b.lo, boxes_[t].lo[a]);
+                b.hi = std::max(b.hi, t.box.hi[a]);
+                b.lo = std::min(b.lo, t.box.lo[a]);
             }
-            // Sweep from the right for the right sides' counts and extents, then from the left.
+        }
+        for (int a = 0; a < 3; ++a) {
+            if (!binned[a]) continue;
+            const Bin* bins = all_bins[a];
+            // Sweep from the right for the right sides' counts and extents, then from the left. An empty
+            // bin changes neither: its costs are its neighbour's, copied, and as a split it ties with the
+            // bin before it, which wins (small nodes have mostly empty bins).
             double right_cost[kSahBins];
             std::uint32_t count = 0;
             float right_lo = kInf;
             for (int k = kSahBins - 1; k > 0; --k) {
+                if (bins[k].count == 0 && k < kSahBins - 1) {
+                    right_cost[k] = right_cost[k + 1];
+                    continue;
+                }
                 count += bins[k].count;
                 right_lo = std::min(right_lo, bins[k].lo);
                 Box3 cell = r.box;
@@ -214,9 +246,10 @@ private:
             count = 0;
             float left_hi = -kInf;
             for (int k = 0; k < kSahBins - 1; ++k) {
+                if (bins[k].count == 0) continue;
                 count += bins[k].count;
                 left_hi = std::max(left_hi, bins[k].hi);
-                if (count == 0 || count == r.size()) continue;
+                if (count == r.size()) continue;
                 Box3 cell = r.box;
                 cell.hi[a] = std::min(cell.hi[a], left_hi);
                 const double cost = p_.traversal_cost + p_.intersection_cost * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
@@ -229,7 +262,7 @@ private:
         if (best_axis < 0 || (leaf_is_cheaper && r.size() <= static_cast<std::uint32_t>(p_.sah_max_leaf)))
             return Decision{};
         const float lo = centres.lo[best_axis], scale = kSahBins / (centres.hi[best_axis] - lo);
-        return split_at(r, best_axis, [&](std::uint32_t t) { return bin_of(centres_[t][best_axis], lo, scale) <= best_bin; });
+        return split_at(r, best_axis, [&](const Item& t) { return bin_of(t.centre()[best_axis], lo, scale) <= best_bin; });
     }
 
     static int bin_of(float centre, float lo, float scale) {
@@ -293,9 +326,7 @@ private:
 
     std::span<const Triangle> tris_;
     const BihBuildParams& p_;
-    std::vector<Box3> boxes_;
-    std::vector<Vec3> centres_;
-    std::vector<std::uint32_t> order_;
+    std::vector<Item> items_;
 };
 
 }  // namespace

@@ -15,6 +15,7 @@ public:
         const Timer timer;
         tree_ = detail::build_bvh(triangles, options);
         build_seconds_ = timer.seconds();
+        build_cpu_seconds_ = timer.cpu_seconds();
     }
 
     AccelStats stats() const override {
@@ -22,6 +23,7 @@ public:
         s.name = "bvh";
         s.traversal = "wide";
         s.build_seconds = build_seconds_;
+        s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = tree_.nodes.size() * sizeof(detail::BvhNode) + tree_.leaves.size() * sizeof(detail::BvhLeaf);
         s.triangles = triangle_count_;
         TreeReport r;
@@ -55,7 +57,7 @@ private:
     const detail::BvhKernels& kernels_;
     std::size_t triangle_count_;
     detail::BvhTree tree_;
-    double build_seconds_ = 0.0;
+    double build_seconds_ = 0.0, build_cpu_seconds_ = 0.0;
 };
 
 }  // namespace

@@ -224,6 +224,7 @@ public:
         const Timer build;
         commit_scene();
         build_seconds_ = build.seconds();
+        build_cpu_seconds_ = build.cpu_seconds();
     }
 
     AccelStats stats() const override {
@@ -231,6 +232,7 @@ public:
         s.name = "embree";
         s.traversal = options_.traversal;
         s.build_seconds = build_seconds_;
+        s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = memory_.live();
         s.triangles = triangle_count_;
         s.settings = {{"quality", options_.quality},
@@ -434,7 +436,7 @@ private:
     std::string native_packets_;
     std::size_t triangle_count_ = 0;
     double setup_seconds_ = 0.0;
-    double build_seconds_ = 0.0;
+    double build_seconds_ = 0.0, build_cpu_seconds_ = 0.0;
     // Declared before the handles: Embree calls both back until the device is released.
     ErrorSink errors_;
     MemoryTally memory_;

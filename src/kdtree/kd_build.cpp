@@ -3,15 +3,16 @@
 // Large nodes (more than `sweep_below` references) are split by min-max binning (Shevtsov et al.
 // 2007, section 3.2): per axis, one histogram counts where reference boxes start and one where they
 // end; prefix sums give the exact counts left and right of every bin boundary, where the SAH is
-// evaluated. Smaller nodes use the exact sweep of Wald & Havran (2006, section 4): events (start,
-// end, or planar for a box flat on the axis) sorted once per axis, kept sorted through every split by
-// partition and merge, so that the build below the switch costs O(N log N). Straddling triangles are
-// clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes are tight.
-//
-// Speed, without changing a bit of the tree: events are single integers (Event, kd_event.hpp), the
-// recursion reuses per-thread buffers by depth instead of allocating per node, the hot loops avoid
-// branches whose direction the data decides, and the sweep computes the SAH's divisions only for
-// candidates that may win (SplitSearch, kd_sah.hpp). Clipping for perfect splits: kd_clip.hpp.
+// evaluated. Smaller nodes get the exact split of the event sweep (Wald & Havran 2006, sections 4.2
+// and 4.3: every start, end and planar position of a reference box a candidate), found without
+// sorting every event: min-max bins give, for every candidate in a bin, a lower bound of its SAH cost
+// (the counts at the bin's edges, the areas at its ends), and only the events of the bins whose bound
+// is not above the cost of a candidate already found are sorted and swept (branch and bound). The
+// choice, ties included, is exactly the full sweep's, so the tree is the one W&H's sweep builds, at
+// the price of one binning pass, a few gathering passes and small sorts per node. Straddling
+// triangles are clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes
+// are tight; references are partitioned into per-thread buffers indexed by depth, so that no node
+// allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest candidate: kd_sah.hpp.
 //
 // Parallelism: the two children of a large node are built as separate tasks, each into its own node
 // array; a final pass lays the pieces out depth-first. The layout depends only on the tree, never on
@@ -22,8 +23,10 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -48,18 +51,35 @@ using namespace kdbuild;
 
 // Nodes with fewer references are built by one task.
 constexpr std::size_t kParallelMin = 2048;
+// Passes over large nodes in parallel builds (KdBuildParams::parallel_pass_min) work in blocks of
+// this many references whose results are combined in block order: the same counts and the same
+// reference order as one thread's.
+constexpr std::size_t kBlock = 16384;
+// Nodes with at least this many references give their children buffers of their own (sequential()).
+constexpr std::size_t kOwnedMin = 65536;
+// The exact search keeps sorted events (W&H's O(N log N) sweep) in nodes this small; larger ones are
+// bounded by bins first.
+constexpr std::size_t kEventsBelow = 256;
+// Bins per axis of the exact search's bounds: about one per 8 references, within these limits.
+constexpr int kBoundBinsMin = 4, kBoundBinsMax = 256;
+// How far, in bins, the bounds reach beyond a bin's edges (see best_split_exact).
+constexpr double kEdgeMargin = 1.0 / 64;
 
 // What the builder knows about one node: its cell, its path, and its references either as boxes
-// (binning) or as sorted event lists (sweep). Moved, never copied: `events` may view `owned`.
+// (binning, bounded exact search) or as sorted event lists (sweep). Moved, never copied (a moved
+// vector keeps its storage): `refs` may view `owned`, `events` may view `owned_events`; otherwise
+// they lie in a per-thread buffer.
 struct Work {
     Box3 cell;
+    Box3 bounds;  // boxes: the union of the references' boxes
     int depth = 0;
     int bad_refines = 0;
     bool events_mode = false;
-    std::vector<Ref> refs;
+    std::span<Ref> refs;
+    std::vector<Ref> owned;
     std::span<const Event> events[3];  // per axis, sorted
     std::size_t triangles = 0;         // events mode: one reference per triangle
-    std::vector<Event> owned;          // the events' storage, unless a per-thread buffer holds them
+    std::vector<Event> owned_events;
 
     Work() = default;
     Work(Work&&) = default;
@@ -78,10 +98,35 @@ struct Scratch {
     // Events of the clipped straddlers, per child and axis: sorted lists in their storage.
     std::vector<Event> clipped_storage[2][3];
     std::span<const Event> clipped[2][3];
-    // By depth: the events of a node that switches from boxes to events, and the children's events
-    // of the node being split (by the children's depth).
+    // By depth: the events of a node that switches from boxes to events, and the children's
+    // references or events of the node being split (by the children's depth).
     std::array<std::vector<Event>, kKdMaxDepth + 1> converted;
-    std::array<std::array<std::vector<Event>, 2>, kKdMaxDepth + 1> children;
+    std::array<std::array<std::vector<Ref>, 2>, kKdMaxDepth + 1> children;
+    std::array<std::array<std::vector<Event>, 2>, kKdMaxDepth + 1> children_events;
+    std::vector<std::uint32_t> starts, ends;  // histograms, per axis
+    std::vector<Event> events;                // the bounded search's gathered events of one axis
+};
+
+// Min-max bins of one axis over [lo, lo + bins / scale]: bin(x) is monotone in x, so a box starting
+// in a lower bin than a candidate starts before it, and one ending in a higher bin ends after it.
+struct AxisBins {
+    float lo = 0.f, scale = 0.f;  // scale 0: one bin holds everything
+    int count = 1;
+    // Where hi - lo is subnormal, scale is inf and the product inf or NaN, which no int holds.
+    int bin(float x) const {
+        const float k = (x - lo) * scale;
+        return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(count - 1))) : 0;
+    }
+};
+
+// The exact search's bins of one axis: the first holds what lies at or below the cell's low plane,
+// the last what lies at or above its high plane (no candidate lies there: W&H take planes inside
+// the cell only), the ones between are min-max bins over the references' tight bounds.
+struct EdgeBins {
+    AxisBins inner;
+    float cell_lo = 0.f, cell_hi = 0.f;
+    int count = 3;
+    int bin(float x) const { return x <= cell_lo ? 0 : x >= cell_hi ? count - 1 : 1 + inner.bin(x); }
 };
 
 class KdBuilder {
@@ -97,13 +142,15 @@ public:
         KdTree tree;
         tree.triangle_count = tris_.size();
         Work root;
-        root.refs.reserve(tris_.size());
+        root.owned.reserve(tris_.size());
         for (std::uint32_t i = 0; i < tris_.size(); ++i) {
             const Box3 b = tris_[i].bounds();
             root.cell.extend(b);
-            root.refs.push_back({i, b});
+            root.owned.push_back({i, b});
         }
+        root.refs = root.owned;
         if (tris_.empty()) root.cell = Box3{Vec3(0.f), Vec3(0.f)};
+        root.bounds = root.cell;
         tree.bounds = root.cell;
         std::unique_ptr<Subtree<KdNode>> top;
         auto run = [&] { top = subtree(std::move(root)); };
@@ -142,7 +189,8 @@ private:
         out->nodes[0] = KdNode::inner(d.split.axis, d.split.pos, 0);
         const Box3 cell = w.cell;
         Work left, right;
-        split(std::move(w), d.split, left, right, left.owned, right.owned, scratch_.local());
+        split(std::move(w), d.split, left, right, {left.owned, right.owned, left.owned_events, right.owned_events},
+              scratch_.local());
         tbb::task_group group;
         group.run([&] { out->left = subtree(std::move(left)); });
         out->right = subtree(std::move(right));
@@ -167,8 +215,13 @@ private:
         out.nodes.resize(out.nodes.size() + 2);
         out.nodes[slot] = KdNode::inner(d.split.axis, d.split.pos, pair);
         Work left, right;
-        auto& buffers = scratch.children[w.depth + 1];
-        split(std::move(w), d.split, left, right, buffers[0], buffers[1], scratch);
+        auto& refs = scratch.children[w.depth + 1];
+        auto& events = scratch.children_events[w.depth + 1];
+        // A large node's children own their references, freed once they are split in turn: a
+        // per-depth buffer would keep the largest node of its depth for the rest of the build.
+        const bool owned = !w.events_mode && w.size() >= kOwnedMin;
+        split(std::move(w), d.split, left, right,
+              {owned ? left.owned : refs[0], owned ? right.owned : refs[1], events[0], events[1]}, scratch);
         const double left_cost = sequential(std::move(left), out, pair, scratch);
         const double right_cost = sequential(std::move(right), out, pair + 1, scratch);
         const double cost = split_cost(cell, d.split, left_cost, right_cost);
@@ -225,10 +278,12 @@ private:
         d.size = n;
         const SahCost sah(w.cell, p_);
         if (n > static_cast<std::size_t>(p_.leaf_size) && w.depth < depth_limit_ && sah.splittable()) {
-            const bool sweep = p_.method == KdBuildMethod::sweep ||
+            const bool exact = p_.method == KdBuildMethod::sweep ||
                                (p_.method == KdBuildMethod::hybrid && n <= static_cast<std::size_t>(p_.sweep_below));
-            if (sweep && !w.events_mode) to_events(w, scratch.converted[w.depth]);
-            d.split = w.events_mode ? best_split_sweep(w, sah) : best_split_binned(w, sah);
+            if (exact && n <= kEventsBelow && !w.events_mode) to_events(w, scratch.converted[w.depth]);
+            d.split = w.events_mode ? best_split_sweep(w, sah)
+                      : exact       ? best_split_exact(w, sah, scratch)
+                                    : best_split_binned(w, sah, scratch);
             if (d.split.axis >= 0) {
                 const double leaf_cost = sah.leaf(n);
                 d.leaf = false;
@@ -239,21 +294,6 @@ private:
             }
         }
         return d;
-    }
-
-    // Splits `w` (consumed) into the children's Work; their events, if any, go to the two buffers.
-    void split(Work&& w, const Split& s, Work& left, Work& right, std::vector<Event>& left_events,
-               std::vector<Event>& right_events, Scratch& scratch) const {
-        left.cell = right.cell = w.cell;
-        left.cell.hi[s.axis] = right.cell.lo[s.axis] = s.pos;
-        for (Work* c : {&left, &right}) {
-            c->depth = w.depth + 1;
-            c->bad_refines = w.bad_refines;
-            c->events_mode = w.events_mode;
-        }
-        if (w.events_mode) split_events(w, s, left, right, left_events, right_events, scratch);
-        else split_refs(w, s, left, right);
-        w = Work{};
     }
 
     // Switches `w` from boxes to events, sorted once here (W&H section 4.2), kept in `buffer`.
@@ -269,7 +309,8 @@ private:
         }
         w.triangles = n;
         w.events_mode = true;
-        std::vector<Ref>().swap(w.refs);
+        w.refs = {};
+        std::vector<Ref>().swap(w.owned);
     }
 
     // Writes the events of a reference with box `box` on axis `a` to out[0] and maybe out[1];
@@ -315,35 +356,67 @@ private:
         return search.best();
     }
 
-    // The position of a run of events at equal floats as the float order has it: that of its
-    // first event, the one with the smallest key. (The run's events differ only at zero: -0 or +0.)
-    static float run_position(std::span<const Event> run) {
-        return std::min_element(run.begin(), run.end(), [](Event a, Event b) { return a.key() < b.key(); })->pos();
-    }
-
-    // Shevtsov et al. section 3.2: min-max binning over the references' tight bounds.
-    Split best_split_binned(const Work& w, const SahCost& sah) const {
-        SplitSearch search(sah);
-        Box3 tight;
-        for (const Ref& r : w.refs) tight.extend(r.box);
-        tight = intersection(tight, w.cell);
-        const int bins = p_.bins;
-        std::vector<std::uint32_t> starts(bins), ends(bins);
+    // Bins of `bins` per axis over the references' tight bounds (an axis without extent: one bin).
+    static std::array<AxisBins, 3> axis_bins(const Work& w, int bins) {
+        const Box3 tight = intersection(w.bounds, w.cell);
+        std::array<AxisBins, 3> out;
         for (int a = 0; a < 3; ++a) {
             const float lo = tight.lo[a], hi = tight.hi[a];
+            out[a].lo = lo;
             if (!(lo < hi)) continue;
-            const float scale = static_cast<float>(bins) / (hi - lo);
-            // Where hi - lo is subnormal, scale is inf and the product inf or NaN, which no int holds.
-            auto bin = [&](float x) {
-                const float k = (x - lo) * scale;
-                return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(bins - 1))) : 0;
-            };
-            std::fill(starts.begin(), starts.end(), 0u);
-            std::fill(ends.begin(), ends.end(), 0u);
-            for (const Ref& r : w.refs) {
-                ++starts[bin(r.box.lo[a])];
-                ++ends[bin(r.box.hi[a])];
+            out[a].scale = static_cast<float>(bins) / (hi - lo);
+            out[a].count = bins;
+        }
+        return out;
+    }
+
+    // Per axis, how many reference boxes start and end in each bin: scratch.starts and .ends hold
+    // axis a's histogram of bins[a].count bins at a * stride.
+    template <class Bins>
+    static void count(std::span<const Ref> refs, const std::array<Bins, 3>& bins, std::size_t stride,
+                      std::uint32_t* starts, std::uint32_t* ends) {
+        for (const Ref& r : refs)
+            for (int a = 0; a < 3; ++a) {
+                ++starts[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.lo[a]))];
+                ++ends[a * stride + static_cast<std::size_t>(bins[a].bin(r.box.hi[a]))];
             }
+    }
+    template <class Bins>
+    void histograms(const Work& w, const std::array<Bins, 3>& bins, std::size_t stride, Scratch& scratch) const {
+        scratch.starts.assign(3 * stride, 0u);
+        scratch.ends.assign(3 * stride, 0u);
+        if (!parallel_pass(w)) return count(w.refs, bins, stride, scratch.starts.data(), scratch.ends.data());
+        const std::size_t blocks = (w.refs.size() + kBlock - 1) / kBlock;
+        std::vector<std::uint32_t> starts(blocks * 3 * stride, 0u), ends(blocks * 3 * stride, 0u);
+        tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+            count(block(w.refs, b), bins, stride, &starts[b * 3 * stride], &ends[b * 3 * stride]);
+        });
+        for (std::size_t b = 0; b < blocks; ++b)
+            for (std::size_t i = 0; i < 3 * stride; ++i) {
+                scratch.starts[i] += starts[b * 3 * stride + i];
+                scratch.ends[i] += ends[b * 3 * stride + i];
+            }
+    }
+
+    bool parallel_pass(const Work& w) const { return p_.threads != 1 && !w.events_mode && w.refs.size() >= p_.parallel_pass_min; }
+    static std::span<Ref> block(std::span<Ref> refs, std::size_t b) {
+        return refs.subspan(b * kBlock, std::min(kBlock, refs.size() - b * kBlock));
+    }
+
+    // Shevtsov et al. section 3.2: min-max binning over the references' tight bounds; the candidates
+    // are the bin boundaries.
+    Split best_split_binned(const Work& w, const SahCost& sah, Scratch& scratch) const {
+        SplitSearch search(sah);
+        const int bins = p_.bins;
+        const auto axes = axis_bins(w, bins);
+        const auto stride = static_cast<std::size_t>(bins);
+        histograms(w, axes, stride, scratch);
+        const Box3 tight = intersection(w.bounds, w.cell);
+        for (int a = 0; a < 3; ++a) {
+            if (axes[a].count == 1) continue;  // no extent
+            const std::uint32_t* starts = &scratch.starts[a * stride];
+            const std::uint32_t* ends = &scratch.ends[a * stride];
+            const float lo = axes[a].lo, hi = tight.hi[a];
             std::ptrdiff_t nl = 0, nr = static_cast<std::ptrdiff_t>(w.refs.size());
             for (int i = 1; i < bins; ++i) {
                 nl += starts[i - 1];
@@ -354,6 +427,129 @@ private:
             }
         }
         return search.best();
+    }
+
+    // The split W&H's sweep chooses (see the top of this file): bins bound every candidate's cost,
+    // the bin with the lowest bound is swept for a first cost, then every bin whose bound is not above
+    // it is swept, axis by axis and in order, so that the first of equal costs wins as in the full sweep.
+    Split best_split_exact(const Work& w, const SahCost& sah, Scratch& scratch) const {
+        const std::size_t n = w.refs.size();
+        const int inner = sah.nonnegative() ? std::clamp(static_cast<int>(n / 2), kBoundBinsMin, kBoundBinsMax) : 1;
+        const auto inner_bins = axis_bins(w, inner);
+        std::array<EdgeBins, 3> axes;
+        for (int a = 0; a < 3; ++a) axes[a] = {inner_bins[a], w.cell.lo[a], w.cell.hi[a], inner_bins[a].count + 2};
+        const auto stride = static_cast<std::size_t>(inner + 2);
+        histograms(w, axes, stride, scratch);
+        const Box3 tight = intersection(w.bounds, w.cell);
+        // Per axis and bin, the references sure to be left (starting in an earlier bin) and right
+        // (ending in a later one) of any candidate in the bin, and the bound of the bin's costs.
+        std::vector<std::uint32_t>& left_of = scratch.starts;  // prefix sums in place
+        std::vector<std::uint32_t>& right_of = scratch.ends;   // suffix sums in place
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        std::array<double, 3 * (kBoundBinsMax + 2)> bound;
+        std::size_t best_bin = bound.size();
+        for (int a = 0; a < 3; ++a) {
+            std::uint32_t* l = &left_of[a * stride];
+            std::uint32_t* r = &right_of[a * stride];
+            double* b = &bound[a * stride];
+            const int count = axes[a].count;
+            std::uint32_t sum = 0;
+            for (int k = 0; k < count; ++k) sum += std::exchange(l[k], sum);
+            sum = 0;
+            for (int k = count - 1; k >= 0; --k) sum += std::exchange(r[k], sum);
+            std::fill(b, b + count, kInf);  // the edge bins hold no candidate
+            const float cell_lo = w.cell.lo[a], cell_hi = w.cell.hi[a];
+            if (!(cell_lo < cell_hi)) continue;
+            // A candidate of inner bin j lies between its edges, give or take the float rounding of
+            // bin(): three roundings of relative 2^-24 each, at most 256 * 2^-22 of a bin, far below
+            // kEdgeMargin.
+            const AxisBins& in = axes[a].inner;
+            const double width = (double(tight.hi[a]) - in.lo) / in.count;
+            for (int j = 0; j < in.count; ++j) {
+                const int k = j + 1;
+                const double x_lo = j == 0 ? cell_lo : std::max<double>(cell_lo, in.lo + (j - kEdgeMargin) * width);
+                const double x_hi =
+                    j == in.count - 1 ? cell_hi : std::min<double>(cell_hi, in.lo + (j + 1 + kEdgeMargin) * width);
+                const auto nl = static_cast<std::ptrdiff_t>(l[k]), nr = static_cast<std::ptrdiff_t>(r[k]);
+                b[k] = std::min(sah.estimate(sah.areas_at(a, x_lo), nl, nr), sah.estimate(sah.areas_at(a, x_hi), nl, nr));
+                if (best_bin == bound.size() || b[k] < bound[best_bin]) best_bin = a * stride + static_cast<std::size_t>(k);
+            }
+        }
+        double limit = kInf;
+        std::uint8_t chosen[kBoundBinsMax + 2];
+        if (inner > 1 && best_bin < bound.size()) {
+            const auto a = static_cast<int>(best_bin / stride);
+            const std::size_t k = best_bin % stride;
+            std::fill(chosen, chosen + stride, std::uint8_t{0});
+            chosen[k] = 1;
+            SplitSearch first(sah);
+            sweep_bins(w, sah, a, axes[a], chosen, &left_of[a * stride], &right_of[a * stride], first, scratch);
+            if (first.best().axis >= 0) limit = first.best().cost * (1.0 + 0x1p-40);
+        }
+        SplitSearch search(sah);
+        for (int a = 0; a < 3; ++a) {
+            bool any = false;
+            for (int k = 0; k < axes[a].count; ++k) {
+                chosen[k] = bound[a * stride + k] <= limit;
+                any |= chosen[k] != 0;
+            }
+            if (any) sweep_bins(w, sah, a, axes[a], chosen, &left_of[a * stride], &right_of[a * stride], search, scratch);
+        }
+        return search.best();
+    }
+
+    // W&H section 4.3 over the events of the chosen bins of axis `a`, sorted: at each position, the
+    // ends and planars there leave the right side, the plane is evaluated with the planars on either
+    // side, then the starts and planars join the left side. Entering a bin, the counts are the bin's
+    // `left_of` and `right_of` (plus the references with events in it, on the right).
+    static void sweep_bins(const Work& w, const SahCost& sah, int a, const EdgeBins& axis, const std::uint8_t* chosen,
+                           const std::uint32_t* left_of, const std::uint32_t* right_of, SplitSearch& search,
+                           Scratch& scratch) {
+        std::vector<Event>& ev = scratch.events;
+        ev.clear();
+        for (const Ref& r : w.refs) {
+            const float lo = r.box.lo[a], hi = r.box.hi[a];
+            const bool planar = lo == hi;
+            if (chosen[axis.bin(lo)]) ev.emplace_back(lo, planar ? kPlanar : kStart, r.triangle);
+            if (!planar && chosen[axis.bin(hi)]) ev.emplace_back(hi, kEnd, r.triangle);
+        }
+        std::sort(ev.begin(), ev.end());
+        const float lo = w.cell.lo[a], hi = w.cell.hi[a];
+        const auto n = static_cast<std::ptrdiff_t>(w.refs.size());
+        std::ptrdiff_t nl = 0, nr = n;
+        int bin = -1;
+        for (std::size_t i = 0; i < ev.size();) {
+            const std::size_t first = i;
+            const int k = axis.bin(ev[i].pos());
+            if (k != bin) {
+                bin = k;
+                nl = left_of[k];
+                nr = k == 0 ? n : static_cast<std::ptrdiff_t>(right_of[k - 1]);  // ending in bin k or later
+            }
+            const std::uint32_t at = ev[i].position_class();
+            std::ptrdiff_t leaving = 0, planars = 0, joining = 0;  // ends and planars, planars, starts and planars
+            do {
+                const std::uint32_t t = ev[i].type();  // kEnd 0, kPlanar 1, kStart 2
+                leaving += (t ^ 2) >> 1;
+                planars += t & 1;
+                joining += (t + 1) >> 1;
+            } while (++i < ev.size() && ev[i].position_class() == at);
+            nr -= leaving;
+            const float pos = ev[first].pos();
+            if (lo < pos && pos < hi) {
+                const auto areas = sah.areas(a, pos);
+                const float split = pos == 0.f ? run_position(std::span(ev).subspan(first, i - first)) : pos;
+                search.offer(a, split, areas, nl + planars, nr, true);
+                if (planars > 0) search.offer(a, split, areas, nl, nr + planars, false);  // else the same cost
+            }
+            nl += joining;
+        }
+    }
+
+    // The position of a run of events at equal floats as the float order has it: that of its
+    // first event, the one with the smallest key. (The run's events differ only at zero: -0 or +0.)
+    static float run_position(std::span<const Event> run) {
+        return std::min_element(run.begin(), run.end(), [](Event a, Event b) { return a.key() < b.key(); })->pos();
     }
 
     // The parts of a straddling triangle in the two children of `cell`: clipped (perfect splits), or
@@ -367,24 +563,86 @@ private:
         return {intersection(b, lcell), intersection(b, rcell)};
     }
 
-    void split_refs(const Work& w, const Split& s, Work& left, Work& right) const {
-        const int a = s.axis;
-        left.refs.reserve(w.refs.size());
-        right.refs.reserve(w.refs.size());
-        for (const Ref& r : w.refs) {
-            const bool planar_here = r.box.lo[a] == s.pos && r.box.hi[a] == s.pos;
-            const bool goes_left = r.box.lo[a] < s.pos || planar_here;
-            const bool goes_right = r.box.hi[a] > s.pos;
-            if (goes_left && goes_right) {
-                const auto [lb, rb] = child_boxes(r.triangle, w.cell, s);
-                if (!lb.is_empty()) left.refs.push_back({r.triangle, lb});
-                if (!rb.is_empty()) right.refs.push_back({r.triangle, rb});
-            } else if (goes_left) {
-                left.refs.push_back(r);
-            } else {
-                right.refs.push_back(r);
+    // Where a split writes the children's references or events (grown, never shrunk).
+    struct ChildBuffers {
+        std::vector<Ref>&left_refs, &right_refs;
+        std::vector<Event>&left_events, &right_events;
+    };
+
+    // Splits `w` (consumed) into the children's Work.
+    void split(Work&& w, const Split& s, Work& left, Work& right, ChildBuffers out, Scratch& scratch) const {
+        left.cell = right.cell = w.cell;
+        left.cell.hi[s.axis] = right.cell.lo[s.axis] = s.pos;
+        for (Work* c : {&left, &right}) {
+            c->depth = w.depth + 1;
+            c->bad_refines = w.bad_refines;
+            c->events_mode = w.events_mode;
+        }
+        if (w.events_mode) split_events(w, s, left, right, out.left_events, out.right_events, scratch);
+        else split_refs(w, s, left, right, out.left_refs, out.right_refs);
+        w = Work{};
+    }
+
+    // A box ending at or before the plane goes left, one starting at or after it right, one lying in
+    // it by `planar_left`, and a straddler's clipped parts to the sides they reach (W&H section 4.4).
+    void split_refs(const Work& w, const Split& s, Work& left, Work& right, std::vector<Ref>& left_refs,
+                    std::vector<Ref>& right_refs) const {
+        // Reserved, not resized: a buffer's pages become resident only as far as references fill them.
+        const std::size_t n = w.refs.size();
+        left_refs.clear();
+        right_refs.clear();
+        left_refs.reserve(n);
+        right_refs.reserve(n);
+        Box3 lbounds, rbounds;
+        if (!parallel_pass(w)) {
+            const auto [lb, rb] = partition(w.refs, w.cell, s, left_refs, right_refs);
+            lbounds = lb, rbounds = rb;
+        } else {
+            // Each block into lists of its own, then the lists back to back in block order.
+            const std::size_t blocks = (n + kBlock - 1) / kBlock;
+            std::vector<std::vector<Ref>> lparts(blocks), rparts(blocks);
+            std::vector<std::pair<Box3, Box3>> bounds(blocks);
+            tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+                const std::span<const Ref> refs = block(w.refs, b);
+                lparts[b].reserve(refs.size());
+                rparts[b].reserve(refs.size());
+                bounds[b] = partition(refs, w.cell, s, lparts[b], rparts[b]);
+            });
+            for (std::size_t b = 0; b < blocks; ++b) {
+                left_refs.insert(left_refs.end(), lparts[b].begin(), lparts[b].end());
+                right_refs.insert(right_refs.end(), rparts[b].begin(), rparts[b].end());
+                lbounds.extend(bounds[b].first);
+                rbounds.extend(bounds[b].second);
             }
         }
+        left.refs = left_refs;
+        right.refs = right_refs;
+        left.bounds = lbounds;
+        right.bounds = rbounds;
+    }
+
+    // split_refs() of `refs`, appended to the two lists; returns the bounds of what each received.
+    std::pair<Box3, Box3> partition(std::span<const Ref> refs, const Box3& cell, const Split& s,
+                                    std::vector<Ref>& left_refs, std::vector<Ref>& right_refs) const {
+        const int a = s.axis;
+        Box3 lbounds, rbounds;
+        for (const Ref& r : refs) {
+            const bool planar_here = r.box.lo[a] == s.pos && r.box.hi[a] == s.pos;
+            const bool goes_left = r.box.lo[a] < s.pos || (planar_here && s.planar_left);
+            const bool goes_right = r.box.hi[a] > s.pos || (planar_here && !s.planar_left);
+            if (goes_left && goes_right) {
+                const auto [lb, rb] = child_boxes(r.triangle, cell, s);
+                if (!lb.is_empty()) left_refs.push_back({r.triangle, lb}), lbounds.extend(lb);
+                if (!rb.is_empty()) right_refs.push_back({r.triangle, rb}), rbounds.extend(rb);
+            } else if (goes_left) {
+                left_refs.push_back(r);
+                lbounds.extend(r.box);
+            } else {
+                right_refs.push_back(r);
+                rbounds.extend(r.box);
+            }
+        }
+        return {lbounds, rbounds};
     }
 
     // W&H section 4.4: classify triangles by the split axis's events, clip the straddlers to both

@@ -81,13 +81,18 @@ public:
         n_ = m;
         current_ ^= 1;
     }
-    void clip_to_slab(int a, const Box3& cell) {
-        clip<true>(a, cell.lo[a]);
-        clip<false>(a, cell.hi[a]);
+    // Clips to the slab of `cell` on axis `a`, skipping a plane that the triangle's box `inside` lies
+    // strictly within: it cuts no vertex. (Vertices made by earlier cuts may stray from that box by a
+    // few roundings in double, far less than the float step between box and plane unless coordinates
+    // differ by many orders of magnitude; a cut skipped there would only leave the box a little larger,
+    // still conservative.)
+    [[gnu::always_inline]] void clip_to_slab(int a, const Box3& cell, const Box3& inside) {
+        if (!(inside.lo[a] > cell.lo[a])) clip<true>(a, cell.lo[a]);
+        if (!(inside.hi[a] < cell.hi[a])) clip<false>(a, cell.hi[a]);
     }
 
     // Bounds rounded outward and cut to `cell`; empty when nothing is left.
-    Box3 bounds(const Box3& cell) const {
+    [[gnu::always_inline]] Box3 bounds(const Box3& cell) const {
         if (n_ == 0) return Box3::empty();
         const P* v = buffers_[current_];
         double lo[3], hi[3];
@@ -114,18 +119,20 @@ private:
 
 // Bounds of the parts of `tri` in the two children of `cell` split at `pos` on `axis`: each is the
 // triangle clipped to the child cell's six planes in the order x-lo, x-hi, y-lo, ..., z-hi. The two
-// children share the planes before the split axis, so that prefix is clipped once for both.
+// children share the planes before the split axis, so that prefix is clipped once for both; planes
+// that cut no vertex of the triangle's box are skipped (the same polygon: see clip_to_slab).
 inline std::pair<Box3, Box3> clipped_child_bounds(const Triangle& tri, const Box3& cell, int axis, float pos) {
     Box3 lcell = cell, rcell = cell;
     lcell.hi[axis] = rcell.lo[axis] = pos;
+    const Box3 inside = tri.bounds();
     ClippedPolygon left(tri);
-    for (int a = 0; a < axis; ++a) left.clip_to_slab(a, cell);
+    for (int a = 0; a < axis; ++a) left.clip_to_slab(a, cell, inside);
     ClippedPolygon right = left;
-    left.clip_to_slab(axis, lcell);
-    right.clip_to_slab(axis, rcell);
+    left.clip_to_slab(axis, lcell, inside);
+    right.clip_to_slab(axis, rcell, inside);
     for (int a = axis + 1; a < 3; ++a) {
-        left.clip_to_slab(a, cell);
-        right.clip_to_slab(a, cell);
+        left.clip_to_slab(a, cell, inside);
+        right.clip_to_slab(a, cell, inside);
     }
     return {left.bounds(lcell), right.bounds(rcell)};
 }

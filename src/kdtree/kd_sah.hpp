@@ -32,6 +32,11 @@ public:
         const double wl = double(pos) - cell_.lo[a], wr = double(cell_.hi[a]) - pos;
         return {constant_[a] + wl * linear_[a], constant_[a] + wr * linear_[a]};
     }
+    // areas() at any point x of the axis, for bounds of the cost between candidates.
+    std::pair<double, double> areas_at(int a, double x) const {
+        const double wl = x - cell_.lo[a], wr = double(cell_.hi[a]) - x;
+        return {constant_[a] + wl * linear_[a], constant_[a] + wr * linear_[a]};
+    }
     // Probabilities that a ray through the cell passes through the left and the right child.
     std::pair<double, double> probabilities(int a, float pos) const {
         const auto [al, ar] = areas(a, pos);
@@ -83,7 +88,7 @@ public:
 
     // Whether a candidate with this estimate may be cheaper than the best.
     bool may_improve(double estimate) const { return estimate < bound_; }
-    void offer(int axis, float pos, std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr,
+    [[gnu::always_inline]] void offer(int axis, float pos, std::pair<double, double> areas, std::ptrdiff_t nl, std::ptrdiff_t nr,
                bool planar_left) {
         if (!may_improve(sah_.estimate(areas, nl, nr))) return;
         const double cost = sah_.split(areas, nl, nr);

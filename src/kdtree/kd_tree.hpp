@@ -56,6 +56,9 @@ struct KdBuildParams {
     int max_bad_refines = 3;
     // Build threads; 0: all hardware threads. The tree is the same for every value.
     unsigned threads = 0;
+    // In parallel builds, nodes with at least this many references are also binned and partitioned by
+    // several threads (not a `-P` parameter: tests lower it to check that the tree stays the same).
+    std::size_t parallel_pass_min = 65536;
 
     int depth_limit(std::size_t triangles) const;
 };
