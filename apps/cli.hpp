@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "cellrt/accel.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 
 namespace cellrt::cli {
 

@@ -26,7 +26,7 @@
 
 #include "accel/local_store_registry.hpp"
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/workload.hpp"

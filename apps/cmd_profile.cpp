@@ -15,7 +15,7 @@
 #include "profile/frame_profile.hpp"
 #include "profile/hardware_counters.hpp"
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
 

@@ -9,7 +9,7 @@
 #include "accel/local_store_registry.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"

@@ -36,7 +36,7 @@
 #include "cellrt/image.hpp"
 #include "cellrt/sampling.hpp"
 #include "cellrt/scene.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "cellrt/workload.hpp"
 
 namespace {

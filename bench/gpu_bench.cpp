@@ -18,7 +18,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/scene.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "cellrt/workload.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 
 #include <time.h>
 
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 
 namespace cellrt::python {
 namespace {

@@ -15,6 +15,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
+#include "cellrt/version.hpp"
 
 namespace cellrt::python {
 namespace {
@@ -198,7 +199,7 @@ PYBIND11_MODULE(cellrt, m) {
     using namespace cellrt;
     using namespace cellrt::python;
     m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
-    m.attr("__version__") = CELLRT_VERSION;
+    m.attr("__version__") = CELLRT_VERSION_STRING;
     py::register_exception<Error>(m, "Error", PyExc_ValueError);
 
     py::class_<TreeReport>(m, "TreeReport", "A tree's build report: its shape, references per triangle, SAH cost")

@@ -14,7 +14,7 @@
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "error_of.hpp"
 #include "scenes.hpp"
 #include "schedule/worker_team.hpp"

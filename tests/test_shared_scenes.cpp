@@ -10,7 +10,7 @@
 #include <string>
 
 #include "cellrt/scene.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "sanitizers.hpp"
 #include "scenes.hpp"
 

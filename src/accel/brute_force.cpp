@@ -1,7 +1,7 @@
 #include "accel/brute_force_listing.hpp"
 #include "cellrt/brute_force.hpp"
 
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "accel/packet_table.hpp"
 #include "kernel/param_reader.hpp"
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "accel/packet_table.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "kernel/param_reader.hpp"
 
 namespace cellrt::detail {

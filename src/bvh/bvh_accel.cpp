@@ -1,7 +1,7 @@
 #include "bvh/bvh_accel.hpp"
 
 #include "cellrt/error.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "kernel/param_reader.hpp"
 
 namespace cellrt {

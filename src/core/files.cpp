@@ -1,4 +1,4 @@
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 
 #include <algorithm>
 #include <cctype>

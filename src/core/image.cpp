@@ -10,7 +10,7 @@
 #include <stb_image_write.h>
 
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 
 namespace cellrt {
 namespace {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cellrt/device.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "cuda/cuda_check.cuh"
 #include "cuda/trace_kernels.cuh"
 #include "kernel/named.hpp"

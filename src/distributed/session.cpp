@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 
 namespace cellrt::distributed {
 

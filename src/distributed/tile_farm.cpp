@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 
 namespace cellrt::distributed {
 namespace {

@@ -13,7 +13,7 @@
 #include <numeric>
 
 #include "cellrt/error.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "kernel/param_reader.hpp"
 #include "kernel/subtree.hpp"
 

@@ -14,7 +14,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "cached_memory.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "kernel/named.hpp"
 #include "kernel/param_reader.hpp"
 #include "kernel/traversal.hpp"

@@ -5,7 +5,7 @@
 
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "cellrt/workload.hpp"
 #include "schedule/cache_line.hpp"
 

@@ -13,7 +13,7 @@
 #include <numbers>
 
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 #include "cellrt/loaders.hpp"
 
 namespace cellrt {

@@ -8,7 +8,7 @@
 #include "cellrt/builtin.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
-#include "cellrt/files.hpp"
+#include "core/files.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
 #include "read_file.hpp"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cellrt/error.hpp"
-#include "cellrt/timer.hpp"
+#include "core/timer.hpp"
 #include "cache_line.hpp"
 #include "worker_team.hpp"
 

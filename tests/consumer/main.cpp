@@ -1,6 +1,5 @@
 // A program of a library user: finds the installed package, builds a structure, traces one ray.
-#include <cellrt/accel.hpp>
-#include <cellrt/builtin.hpp>
+#include <cellrt/cellrt.hpp>
 
 #include <cstdio>
 
@@ -12,6 +11,6 @@ int main() {
     ray.dir = scene.camera.look_at - scene.camera.position;
     cellrt::Hit hit;
     accel->intersect(std::span(&ray, 1), std::span(&hit, 1));
-    std::printf("hit triangle %u at t = %g\n", hit.prim, hit.t);
+    std::printf("cellrt %s: hit triangle %u at t = %g\n", CELLRT_VERSION_STRING, hit.prim, hit.t);
     return hit.is_hit() ? 0 : 1;
 }
