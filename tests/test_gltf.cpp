@@ -4,20 +4,19 @@
 // bad file of each kind refused with a message naming the file and the part at fault.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cellrt/loaders.hpp"
 #include "cellrt/scene.hpp"
+#include "temp_dir.hpp"
 #include "error_of.hpp"
 
 namespace cellrt {
@@ -86,21 +85,9 @@ std::string glb(json doc, std::string bin) {
     return out;
 }
 
-class GltfTest : public ::testing::Test {
+class GltfTest : public test::TempDirTest {
 protected:
-    void SetUp() override {
-        static std::atomic<int> counter{0};
-        dir_ = fs::temp_directory_path() / ("cellrt_gltf_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string write(const std::string& name, const std::string& bytes) const {
-        const std::string path = (dir_ / name).string();
-        std::ofstream(path, std::ios::binary) << bytes;
-        return path;
-    }
+    GltfTest() : TempDirTest("cellrt_gltf") {}
 
     // `doc` as name.gltf with its buffer embedded as a data URI.
     std::string embedded(json doc, const std::string& bin = quad_bytes(), const std::string& name = "scene.gltf") const {
@@ -115,7 +102,6 @@ protected:
         return message.substr(std::min(message.size(), path.size() + 2));
     }
 
-    fs::path dir_;
 };
 
 const std::vector<Triangle> kQuad = {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}}, {{0, 0, 0}, {1, 1, 0}, {0, 1, 0}}};

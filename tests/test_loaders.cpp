@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cstring>
 #include <filesystem>
@@ -11,7 +10,6 @@
 #include <functional>
 #include <limits>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -19,6 +17,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
 #include "cellrt/scene.hpp"
+#include "temp_dir.hpp"
 
 namespace cellrt {
 namespace {
@@ -26,24 +25,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh directory per test, removed afterwards.
-class LoaderTest : public ::testing::Test {
+class LoaderTest : public test::TempDirTest {
 protected:
-    void SetUp() override {
-        static std::atomic<int> counter{0};
-        dir_ = fs::temp_directory_path() /
-               ("cellrt_loaders_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string write(const std::string& name, const std::string& bytes) const {
-        const std::string path = (dir_ / name).string();
-        std::ofstream(path, std::ios::binary) << bytes;
-        return path;
-    }
-
-    fs::path dir_;
+    LoaderTest() : TempDirTest("cellrt_loaders") {}
 };
 
 // The message of the cellrt::Error that `load` throws; a failure if it throws nothing.

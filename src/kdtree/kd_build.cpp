@@ -322,9 +322,7 @@ private:
         return planar ? 1 : 2;
     }
 
-    // W&H section 4.3: one pass per axis over the sorted events. At each position, the ends and
-    // planars there leave the right side, the plane is evaluated with the planars on either side,
-    // then the starts and planars join the left side.
+    // W&H section 4.3: one pass per axis over the sorted events, position by position (sweep_position).
     static Split best_split_sweep(const Work& w, const SahCost& sah) {
         SplitSearch search(sah);
         for (int a = 0; a < 3; ++a) {
@@ -332,26 +330,7 @@ private:
             if (!(lo < hi)) continue;
             const std::span<const Event> ev = w.events[a];
             std::ptrdiff_t nl = 0, nr = static_cast<std::ptrdiff_t>(w.triangles);
-            for (std::size_t i = 0; i < ev.size();) {
-                const std::size_t first = i;
-                const std::uint32_t at = ev[i].position_class();
-                std::ptrdiff_t leaving = 0, planars = 0, joining = 0;  // ends and planars, planars, starts and planars
-                do {
-                    const std::uint32_t t = ev[i].type();  // kEnd 0, kPlanar 1, kStart 2
-                    leaving += (t ^ 2) >> 1;
-                    planars += t & 1;
-                    joining += (t + 1) >> 1;
-                } while (++i < ev.size() && ev[i].position_class() == at);
-                nr -= leaving;
-                const float pos = ev[first].pos();
-                if (lo < pos && pos < hi) {
-                    const auto areas = sah.areas(a, pos);
-                    const float split = pos == 0.f ? run_position(ev.subspan(first, i - first)) : pos;
-                    search.offer(a, split, areas, nl + planars, nr, true);
-                    if (planars > 0) search.offer(a, split, areas, nl, nr + planars, false);  // else the same cost
-                }
-                nl += joining;
-            }
+            for (std::size_t i = 0; i < ev.size();) sweep_position(ev, i, a, lo, hi, sah, search, nl, nr);
         }
         return search.best();
     }
@@ -519,31 +498,41 @@ private:
         std::ptrdiff_t nl = 0, nr = n;
         int bin = -1;
         for (std::size_t i = 0; i < ev.size();) {
-            const std::size_t first = i;
             const int k = axis.bin(ev[i].pos());
             if (k != bin) {
                 bin = k;
                 nl = left_of[k];
                 nr = k == 0 ? n : static_cast<std::ptrdiff_t>(right_of[k - 1]);  // ending in bin k or later
             }
-            const std::uint32_t at = ev[i].position_class();
-            std::ptrdiff_t leaving = 0, planars = 0, joining = 0;  // ends and planars, planars, starts and planars
-            do {
-                const std::uint32_t t = ev[i].type();  // kEnd 0, kPlanar 1, kStart 2
-                leaving += (t ^ 2) >> 1;
-                planars += t & 1;
-                joining += (t + 1) >> 1;
-            } while (++i < ev.size() && ev[i].position_class() == at);
-            nr -= leaving;
-            const float pos = ev[first].pos();
-            if (lo < pos && pos < hi) {
-                const auto areas = sah.areas(a, pos);
-                const float split = pos == 0.f ? run_position(std::span(ev).subspan(first, i - first)) : pos;
-                search.offer(a, split, areas, nl + planars, nr, true);
-                if (planars > 0) search.offer(a, split, areas, nl, nr + planars, false);  // else the same cost
-            }
-            nl += joining;
+            sweep_position(ev, i, a, lo, hi, sah, search, nl, nr);
         }
+    }
+
+    // One position of the sweep (W&H section 4.3): the run of events from ev[i] at one position and
+    // class, after which `i` points. Its ends and planars leave the right side, the plane is offered
+    // with the planars on either side, then its starts and planars join the left side. Inlined: it is
+    // the sweep's inner loop.
+    [[gnu::always_inline]] static void sweep_position(std::span<const Event> ev, std::size_t& i, int a, float lo,
+                                                      float hi, const SahCost& sah, SplitSearch& search,
+                                                      std::ptrdiff_t& nl, std::ptrdiff_t& nr) {
+        const std::size_t first = i;
+        const std::uint32_t at = ev[i].position_class();
+        std::ptrdiff_t leaving = 0, planars = 0, joining = 0;  // ends and planars, planars, starts and planars
+        do {
+            const std::uint32_t t = ev[i].type();  // kEnd 0, kPlanar 1, kStart 2
+            leaving += (t ^ 2) >> 1;
+            planars += t & 1;
+            joining += (t + 1) >> 1;
+        } while (++i < ev.size() && ev[i].position_class() == at);
+        nr -= leaving;
+        const float pos = ev[first].pos();
+        if (lo < pos && pos < hi) {
+            const auto areas = sah.areas(a, pos);
+            const float split = pos == 0.f ? run_position(ev.subspan(first, i - first)) : pos;
+            search.offer(a, split, areas, nl + planars, nr, true);
+            if (planars > 0) search.offer(a, split, areas, nl, nr + planars, false);  // else the same cost
+        }
+        nl += joining;
     }
 
     // The position of a run of events at equal floats as the float order has it: that of its
