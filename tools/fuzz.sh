@@ -13,7 +13,7 @@ targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(obj ply view builtin accel cache_layout image_size gltf)
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
-  -DCELLRT_FUZZ=ON -DCELLRT_TESTS=OFF -DCELLRT_BENCH=OFF >/dev/null
+  -DCELLRT_FUZZ=ON -DCELLRT_TESTS=OFF -DCELLRT_BENCH=OFF -DCELLRT_CUDA=OFF >/dev/null
 cmake --build build-fuzz --target fuzz
 
 # Only the kernels may use instructions beyond x86-64's baseline, each set its own (clang's target
