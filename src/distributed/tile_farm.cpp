@@ -125,6 +125,17 @@ RenderOptions tile_options(const RenderOptions& options) {
     return o;
 }
 
+// The frame's renderer for this rank's tiles, or null with `failure` saying why.
+std::unique_ptr<FrameRenderer> start_renderer(const Scene& scene, const Accelerator& accel, const RenderOptions& o,
+                                              std::optional<std::string>& failure) {
+    try {
+        return std::make_unique<FrameRenderer>(scene, accel, o);
+    } catch (const std::exception& e) {
+        failure = e.what();
+        return nullptr;
+    }
+}
+
 // A rank other than 0: traces the tiles rank 0 hands it and returns each; a tile arrives for each
 // tile returned and `ahead` at the start, until rank 0 answers that none is left.
 RankLoad trace_for_master(const Session& session, const Scene& scene, const Accelerator& accel,
@@ -159,12 +170,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     };
     Outbox outbox;
     Image tile;
-    std::unique_ptr<FrameRenderer> renderer;
-    try {
-        renderer = std::make_unique<FrameRenderer>(scene, accel, o);
-    } catch (const std::exception& e) {
-        failure = e.what();
-    }
+    const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
     bool first = true;
     while (!queue.empty() || pending > 0) {
         take(queue.empty());
@@ -223,13 +229,8 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     load.threads = o.threads;
     std::thread local([&] {
         Image tile;
-        std::unique_ptr<FrameRenderer> renderer;
-        try {
-            renderer = std::make_unique<FrameRenderer>(scene, accel, o);
-        } catch (const std::exception& e) {
-            failure = e.what();
-            stop = true;
-        }
+        const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
+        if (!renderer) stop = true;
         for (std::int32_t t = claim(); t != kNoTile; t = claim()) {
             try {
                 RenderStats s;
