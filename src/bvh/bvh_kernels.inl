@@ -14,26 +14,22 @@
 
 static_assert(kLanes == kBvhWidth, "one lane per child and per triangle");
 
-inline F load(const float* p) {
-    F x;
-    std::memcpy(&x, p, sizeof x);
-    return x;
-}
+// Eight floats or words read in place, at any alignment: one vector load (a memcpy into the vector
+// type compiles, under GCC 12, to a load, a store to the stack and a load back).
+typedef float FRow __attribute__((vector_size(4 * kLanes), aligned(4), may_alias));
+typedef std::uint32_t URow __attribute__((vector_size(4 * kLanes), aligned(4), may_alias));
+inline F load(const float* p) { return *reinterpret_cast<const FRow*>(p); }
+inline U load_u(const std::uint32_t* p) { return *reinterpret_cast<const URow*>(p); }
 
-inline U load_u(const std::uint32_t* p) {
-    U x;
-    std::memcpy(&x, p, sizeof x);
-    return x;
-}
-
-// The ray as the box tests of every node see it: its origin, reciprocal direction and margin in all
-// lanes, and for each axis the offset (in floats, from the node's lo[0]) of the planes it enters and
-// leaves a box by, chosen once by the direction's sign.
+// The ray as the box tests of every node see it: its origin and reciprocal direction in all lanes,
+// its tnear and margin, and for each axis the offset (in floats, from the node's lo[0]) of the planes
+// it enters and leaves a box by, chosen once by the direction's sign.
 struct BoxRay {
-    F org[3], inv[3], margin, tnear;
+    F org[3], inv[3];
+    float tnear, margin;
     int enter[3], leave[3];
 
-    explicit BoxRay(const TraversalRay& r) : margin(splat(r.margin)), tnear(splat(r.tnear - r.margin)) {
+    explicit BoxRay(const TraversalRay& r) : tnear(r.tnear), margin(r.margin) {
         for (int a = 0; a < 3; ++a) {
             org[a] = splat(r.org[a]);
             inv[a] = splat(r.inv_dir[a]);
@@ -45,30 +41,42 @@ struct BoxRay {
 };
 
 // A node's children met by the ray within [tnear - margin, cull], as a bit mask, with each one's
-// entry distance.
+// entry distance. The scalar clip() widens every plane distance by the margin before it takes the
+// extremes; here the extremes are widened once: rounding is monotonic, so max(a - m, b - m) is
+// max(a, b) - m bit for bit, and the NaN-keeping max and min skip the same planes either way.
 inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
     static_assert(offsetof(BvhNode, hi) == 3 * kBvhWidth * sizeof(float), "hi follows lo");
     const float* planes = &node.lo[0][0];
-    F enter = r.tnear, leave = splat(cull);
+    F enter = splat(r.tnear), leave = splat(kInfinity);
     for (int a = 0; a < 3; ++a) {
-        const F t0 = (load(planes + r.enter[a]) - r.org[a]) * r.inv[a];
-        const F t1 = (load(planes + r.leave[a]) - r.org[a]) * r.inv[a];
-        enter = max_keep(enter, t0 - r.margin);
-        leave = min_keep(leave, t1 + r.margin);
+        enter = max_keep(enter, (load(planes + r.enter[a]) - r.org[a]) * r.inv[a]);
+        leave = min_keep(leave, (load(planes + r.leave[a]) - r.org[a]) * r.inv[a]);
     }
-    entry = enter;
-    return bits(enter <= leave);
+    const F margin = splat(r.margin);
+    entry = enter - margin;
+    return bits(entry <= min_keep(splat(cull), leave + margin));
 }
+
+// The watertight test's per-ray constants (triangle.hpp's WatertightRay) in all lanes, made once per
+// ray rather than once per leaf, with the offsets (in floats, within one vertex's rows) of the rows
+// that the test reads as its x, y and z.
+struct LeafRay {
+    F ox, oy, oz, sx, sy, sz;
+    int kx, ky, kz;
+
+    explicit LeafRay(const WatertightRay& r)
+        : ox(splat(r.org[r.kx])), oy(splat(r.org[r.ky])), oz(splat(r.org[r.kz])), sx(splat(r.sx)), sy(splat(r.sy)),
+          sz(splat(r.sz)), kx(r.kx * kBvhWidth), ky(r.ky * kBvhWidth), kz(r.kz * kBvhWidth) {}
+};
 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
 // triangle, with t, u, v.
-inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const WatertightRay& r, F& t, F& u, F& v) {
-    const F ox = splat(r.org[r.kx]), oy = splat(r.org[r.ky]), oz = splat(r.org[r.kz]);
-    const F sx = splat(r.sx), sy = splat(r.sy), sz = splat(r.sz);
-    const F a_kz = load(leaf.v[0][r.kz]) - oz, b_kz = load(leaf.v[1][r.kz]) - oz, c_kz = load(leaf.v[2][r.kz]) - oz;
-    const F ax = (load(leaf.v[0][r.kx]) - ox) - sx * a_kz, ay = (load(leaf.v[0][r.ky]) - oy) - sy * a_kz;
-    const F bx = (load(leaf.v[1][r.kx]) - ox) - sx * b_kz, by = (load(leaf.v[1][r.ky]) - oy) - sy * b_kz;
-    const F cx = (load(leaf.v[2][r.kx]) - ox) - sx * c_kz, cy = (load(leaf.v[2][r.ky]) - oy) - sy * c_kz;
+inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u, F& v) {
+    const float *a = leaf.v[0][0], *b = leaf.v[1][0], *c = leaf.v[2][0];
+    const F a_kz = load(a + r.kz) - r.oz, b_kz = load(b + r.kz) - r.oz, c_kz = load(c + r.kz) - r.oz;
+    const F ax = (load(a + r.kx) - r.ox) - r.sx * a_kz, ay = (load(a + r.ky) - r.oy) - r.sy * a_kz;
+    const F bx = (load(b + r.kx) - r.ox) - r.sx * b_kz, by = (load(b + r.ky) - r.oy) - r.sy * b_kz;
+    const F cx = (load(c + r.kx) - r.ox) - r.sx * c_kz, cy = (load(c + r.ky) - r.oy) - r.sy * c_kz;
     F eu = cx * by - cy * bx;
     F ev = ax * cy - ay * cx;
     F ew = bx * ay - by * ax;
@@ -85,7 +93,7 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const Waterti
     const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
-    const F az = sz * a_kz, bz = sz * b_kz, cz = sz * c_kz;
+    const F az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
     const F big_t = eu * az + ev * bz + ew * cz;
     const F inv_det = splat(1.f) / det;
     t = big_t * inv_det;
@@ -113,11 +121,11 @@ inline float horizontal_min(F x) {
 // Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
 // True when an any-hit query is answered.
 template <class Query, class Counters>
-bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, Query& q, Counters& c) {
+bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, Query& q, Counters& c) {
     c.leaf();
     for (std::uint32_t i = 0; i < count; ++i) c.triangle();
     F t, u, v;
-    const I hit = watertight_leaf(leaf, count, r.watertight, t, u, v);
+    const I hit = watertight_leaf(leaf, count, r, t, u, v);
     if constexpr (Query::kAnyHit) {
         return any(hit & (t >= splat(q.tnear)) & (t <= splat(q.tfar)));
     } else {
@@ -138,50 +146,67 @@ bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const TraversalRay& r, 
 
 // The children that are leaves, as a bit mask (the leaf bit is the sign bit of a child word).
 inline unsigned leaf_lanes(const BvhNode& node) {
-    return bits(reinterpret_cast<I>(load_u(node.child)) < 0) & bits(reinterpret_cast<I>(load_u(node.child)) != -1);
+    const I words = reinterpret_cast<I>(load_u(node.child));
+    return bits((words < 0) & (words != -1));
 }
-
-#if defined(CELLRT_SIMD_AVX512)
-inline __m256i load_child_words(const BvhNode& node) {
-    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child));
-}
-#endif
 
 // Deep enough for any tree the builder makes: each level pushes at most seven children, and the
-// binary tree is at most kSahDepth + log2(2^32) levels deep, the wide one no deeper.
+// binary tree is at most kSahDepth + log2(2^32) levels deep, the wide one no deeper. A push writes
+// a whole row of eight, hence the slack above the top.
 inline constexpr int kBvhStackSize = 7 * 96 + 1;
+inline constexpr int kBvhStackSlack = kBvhWidth;
 
-// The children waiting, as two arrays (their words, and the distances at which the ray enters their
-// boxes), so that AVX-512 pushes the children met in two compressing stores, without a loop.
-struct BvhStack {
-    std::uint32_t word[kBvhStackSize];
-    float entry[kBvhStackSize];
-    int size = 0;
-
-    void push(const BvhNode& node, unsigned met, F entries) {
-#if defined(CELLRT_SIMD_AVX512)
-        _mm256_mask_compressstoreu_epi32(word + size, static_cast<__mmask8>(met), load_child_words(node));
-        _mm256_mask_compressstoreu_ps(entry + size, static_cast<__mmask8>(met), reinterpret_cast<__m256>(entries));
-        size += __builtin_popcount(met);
-#else
-        for (; met; met &= met - 1) {
-            const int k = __builtin_ctz(met);
-            word[size] = node.child[k];
-            entry[size++] = entries[k];
-        }
-#endif
+#if defined(CELLRT_SIMD_AVX2) && !defined(CELLRT_SIMD_AVX512)
+// For each 8-bit mask, the indices of its set bits in ascending order, a byte each: the lane
+// permutation that packs the chosen lanes to the front. AVX2 has no compressing store (AVX-512's
+// vpcompressd); a permutation from this table does the same without a loop over the bits, whose
+// trip count an incoherent ray's branch predictor cannot learn.
+struct PackTable {
+    std::uint64_t order[256];
+    constexpr PackTable() : order{} {
+        for (unsigned m = 0; m < 256; ++m)
+            for (unsigned i = 0, n = 0; i < 8; ++i)
+                if (m >> i & 1) order[m] |= std::uint64_t{i} << (8 * n++);
     }
 };
+inline constexpr PackTable kPackTable{};
+#endif
 
+// Pushes the children of `met`: their words and, where `entry_stack` is given, their entry distances.
+inline void push_children(const BvhNode& node, unsigned met, F entries, std::uint32_t* word_stack, float* entry_stack,
+                          int& size) {
+#if defined(CELLRT_SIMD_AVX512)
+    const auto mask = static_cast<__mmask8>(met);
+    _mm256_mask_compressstoreu_epi32(word_stack + size, mask, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child)));
+    if (entry_stack) _mm256_mask_compressstoreu_ps(entry_stack + size, mask, reinterpret_cast<__m256>(entries));
+#elif defined(CELLRT_SIMD_AVX2)
+    const __m256i order = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kPackTable.order[met])));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(word_stack + size),
+                        _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child)), order));
+    if (entry_stack) _mm256_storeu_ps(entry_stack + size, _mm256_permutevar8x32_ps(reinterpret_cast<__m256>(entries), order));
+#else
+    for (unsigned m = met, n = size; m; m &= m - 1, ++n) {
+        word_stack[n] = node.child[__builtin_ctz(m)];
+        if (entry_stack) entry_stack[n] = entries[__builtin_ctz(m)];
+    }
+#endif
+    size += __builtin_popcount(met);
+}
 
 template <class Query, class Counters>
 bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+    // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was met
+    // within it, so its stack needs no entry distances and no pop is culled.
+    constexpr bool kCulls = !Query::kAnyHit;
     const BoxRay box_ray(r);
-    BvhStack stack;
+    const LeafRay leaf_ray(r.watertight);
+    std::uint32_t word_stack[kBvhStackSize + kBvhStackSlack];
+    float entry_stack[kCulls ? kBvhStackSize + kBvhStackSlack : 1];
+    int size = 0;
     std::uint32_t word = 0;  // the root, an inner node
     for (;;) {
         if (BvhNode::is_leaf(word)) {
-            if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), r, q, c)) return true;
+            if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), leaf_ray, q, c)) return true;
         } else {
             c.node();
             const BvhNode& node = nodes[word];
@@ -190,33 +215,37 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
             if constexpr (Query::kAnyHit) {
                 // Any hit ends the query, and leaves end it sooner than subtrees: test the leaves
                 // met at once, and go on only into the inner children.
-                for (unsigned leaves_met = met & leaf_lanes(node); leaves_met; leaves_met &= leaves_met - 1) {
+                const unsigned leaf_children = leaf_lanes(node);
+                for (unsigned leaves_met = met & leaf_children; leaves_met; leaves_met &= leaves_met - 1) {
                     const std::uint32_t w = node.child[__builtin_ctz(leaves_met)];
-                    if (test_leaf(leaves[BvhNode::leaf_index(w)], BvhNode::leaf_count(w), r, q, c)) return true;
+                    if (test_leaf(leaves[BvhNode::leaf_index(w)], BvhNode::leaf_count(w), leaf_ray, q, c)) return true;
                 }
-                met &= ~leaf_lanes(node);
+                met &= ~leaf_children;
             }
             if (met) {
-                // One child met (the common case deep in the tree): go there. Several: push them,
-                // farthest first, and go on with the nearest.
+                // One child met (the common case deep in the tree): go there. Several: the nearest
+                // goes first, the others wait unsorted (sorting them costs more on incoherent rays
+                // than the order saves, and a popped child past the answer is skipped).
                 if ((met & (met - 1)) == 0) {
                     word = node.child[__builtin_ctz(met)];
                     continue;
                 }
-                // The nearest child goes first; the others wait unsorted (sorting them costs more on
-                // incoherent rays than the order saves, and a popped child past the answer is skipped).
                 const F masked = select(met_mask(met), entry, splat(kInfinity));
                 const unsigned nearest = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
                 word = node.child[nearest];
-                stack.push(node, met & ~(1u << nearest), entry);
+                push_children(node, met & ~(1u << nearest), entry, word_stack, kCulls ? entry_stack : nullptr, size);
                 continue;
             }
         }
-        do {
-            if (stack.size == 0) return false;
-            --stack.size;
-        } while (stack.entry[stack.size] > q.cull_t());
-        word = stack.word[stack.size];
+        for (;;) {
+            if (size == 0) return false;
+            --size;
+            if constexpr (kCulls) {
+                if (entry_stack[size] > q.cull_t()) continue;
+            }
+            break;
+        }
+        word = word_stack[size];
     }
 }
 

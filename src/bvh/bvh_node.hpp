@@ -32,10 +32,10 @@ struct alignas(64) BvhNode {
 static_assert(sizeof(BvhNode) == 256, "a wide BVH node is four 64-byte lines: 8 boxes and 8 child words");
 
 // Up to eight triangles: v[vertex][axis][lane], and each lane's index in the scene (kNoHit: unused).
-struct alignas(32) BvhLeaf {
+struct alignas(64) BvhLeaf {
     float v[3][3][kBvhWidth];
     std::uint32_t prim[kBvhWidth];
 };
-static_assert(sizeof(BvhLeaf) == 320, "a wide BVH leaf is nine lanes of coordinates and one of indices");
+static_assert(sizeof(BvhLeaf) == 320, "a wide BVH leaf is nine lanes of coordinates and one of indices: five cache lines");
 
 }  // namespace cellrt::detail

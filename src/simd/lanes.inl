@@ -9,7 +9,26 @@ typedef float F __attribute__((vector_size(4 * kLanes)));
 typedef std::int32_t I __attribute__((vector_size(4 * kLanes)));  // lane masks: -1 true, 0 false
 typedef std::uint32_t U __attribute__((vector_size(4 * kLanes)));
 
-inline F splat(float x) { return F{} + x; }
+// Every lane x: one broadcast instruction where the set has one. (Not F{} + x: an addition of zero,
+// which the compiler may not fold away, costs an instruction per use and turns -0 into +0; and GCC 12
+// builds a vector initialised lane by lane from inserts.)
+// By the vector's size, as lane_bits below.
+template <class V>
+inline V lane_splat(float x) {
+#if defined(CELLRT_SIMD_AVX512)
+    if constexpr (sizeof(V) == 64) return reinterpret_cast<V>(_mm512_set1_ps(x));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2)
+    if constexpr (sizeof(V) == 32) return reinterpret_cast<V>(_mm256_set1_ps(x));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2) || defined(CELLRT_SIMD_SSE)
+    if constexpr (sizeof(V) == 16) return reinterpret_cast<V>(_mm_set1_ps(x));
+#endif
+    V v;
+    for (int i = 0; i < static_cast<int>(sizeof(V) / 4); ++i) v[i] = x;
+    return v;
+}
+inline F splat(float x) { return lane_splat<F>(x); }
 inline I splat_i(std::int32_t x) { return I{} + x; }
 inline U splat_u(std::uint32_t x) { return U{} + x; }
 inline I mask_of(bool b) { return splat_i(b ? -1 : 0); }
