@@ -396,6 +396,7 @@ nlohmann::json bench_scene(const Scene& scene, const Options& o) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
+    bench::check_results_paths({o.json_path});
     const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes);
     nlohmann::json out = nlohmann::json::array();
     // A scene a run: its configurations, Embree's among them, stay together on one process.

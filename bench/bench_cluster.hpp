@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <new>
 #include <string>
@@ -45,6 +46,20 @@ inline std::vector<std::string> found_scenes(const std::string& scenes_dir, cons
         else if (cluster::leader()) print_skipped_scene(names[i], specs[i]);
     }
     return found;
+}
+
+// Refuses, before any run, results files whose folder is not there (on the leader, which writes them):
+// a mistyped path should not cost the sweep.
+inline void check_results_paths(const std::vector<std::string>& paths) {
+    cluster::together([&] {
+        if (!cluster::leader()) return;
+        for (const std::string& path : paths) {
+            if (path.empty()) continue;  // not asked for
+            const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+            if (!std::filesystem::is_directory(folder))
+                throw Error(path + ": folder '" + folder.string() + "' does not exist");
+        }
+    }, "checking the results' paths");
 }
 
 // `text` (a JSON document, say) written whole as `path` by the leader, once every process has got

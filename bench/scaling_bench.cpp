@@ -368,6 +368,7 @@ std::string csv_of(const nlohmann::json& rows) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
+    bench::check_results_paths({o.json_path, o.csv_path});
     const std::string yardstick = yardstick_of(o.configs);
     const Study study = measure(o);
     // One table per configuration, dispatch and packet size; then where the time of the most workers went.

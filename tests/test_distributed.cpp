@@ -253,6 +253,10 @@ TEST_F(DistributedBench, ABadOptionIsOneMessage) {
                    "rank 0: ", "--shading: ", "cellrt_scaling");
     expect_failure(shell(mpirun(2) + CELLRT_BENCH_MPI + " --size 12 --json " + out.string(), dir.path), out,
                    "rank 0: ", "--size '12' must be WIDTHxHEIGHT", "cellrt_bench");
+    // A results file in a folder that is not there: refused before any run.
+    const fs::path lost = dir.path / "missing" / "results.json";
+    expect_failure(shell(mpirun(2) + CELLRT_SCALING_MPI + " --json " + lost.string(), dir.path), out, "rank 0: ",
+                   lost.string() + ": folder '" + lost.parent_path().string() + "' does not exist", "cellrt_scaling");
 }
 
 TEST_F(Distributed, ARankWhoseSceneFailsEndsEveryRank) {
