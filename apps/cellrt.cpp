@@ -3,7 +3,6 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
-#include <sstream>
 
 #include "cellrt/error.hpp"
 #include "cli.hpp"
@@ -23,9 +22,7 @@ int run(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        if (cli::cluster::leader()) return app.exit(e);
-        std::ostringstream silent;  // every rank parsed the same command line; rank 0 speaks for all
-        return app.exit(e, silent, silent);
+        return cli::cluster::exit_parse(app, e);
     }
     const auto subcommands = app.get_subcommands({});
     std::size_t chosen = 0;
@@ -59,7 +56,7 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
     try {
-        cellrt::cli::cluster::start(argc, argv);
+        cellrt::cli::cluster::start(argc, argv, "cellrt");
     } catch (const std::exception& e) {
         std::fprintf(stderr, "cellrt: error: %s\n", e.what());
         return 1;

@@ -1,7 +1,8 @@
-// The processes one command runs on, as the subcommands see them: the plain cellrt program is one
-// process (cluster_local.cpp); cellrt-mpi is the ranks of an MPI job (mpi/cluster_mpi.cpp,
-// docs/DISTRIBUTED.md). The commands are compiled once and call these the same way in both programs;
-// the program links one implementation, so the plain program holds no MPI code at all.
+// The processes one command runs on, as the subcommands see them: the plain programs (cellrt,
+// cellrt_bench, cellrt_scaling) are one process (cluster_local.cpp); their -mpi variants are the ranks
+// of an MPI job (mpi/cluster_mpi.cpp, docs/DISTRIBUTED.md). The commands are compiled once and call
+// these the same way in both programs; the program links one implementation, so the plain program
+// holds no MPI code at all.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include <cstddef>
 #include <exception>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,9 +20,10 @@
 
 namespace cellrt::cli::cluster {
 
-// Before and after everything else: start() joins the job (MPI_Init); finish() returns the exit
-// status agreed by all processes (the largest) and leaves the job.
-void start(int& argc, char**& argv);
+// Before and after everything else: start() joins the job (MPI_Init) and names the program in its
+// messages ("PROGRAM: error: ..."); finish() returns the exit status agreed by all processes (the
+// largest) and leaves the job.
+void start(int& argc, char**& argv, const char* program);
 int finish(int status);
 
 int rank();   // 0 in the plain program
@@ -28,13 +31,24 @@ int ranks();  // 1 in the plain program
 unsigned cores();  // the cores this process may run on (a rank's share of its machine under MPI)
 inline bool leader() { return rank() == 0; }  // prints, and writes the outputs
 
-// Prints the error a command ended with, as "cellrt: error: ..." (under MPI once, by rank 0, for an
+// Prints the error a command ended with, as "PROGRAM: error: ..." (under MPI once, by rank 0, for an
 // error all ranks agreed on, and with the rank's number otherwise).
 void print_error(const std::exception& e);
 
-// The options a distributed command adds (none in the plain program).
+// CLI11's exit for a command line it refused, or for --help: every process parsed the same line, so
+// the leader speaks for all.
+inline int exit_parse(const CLI::App& app, const CLI::ParseError& e) {
+    if (leader()) return app.exit(e);
+    std::ostringstream silent;
+    return app.exit(e, silent, silent);
+}
+
+// The options a distributed command adds (none in the plain program): a frame's, a sweep's (the
+// cache study's: its ranks each load every scene) and a benchmark's (whose sweeps run for hours, so
+// that a rank's wait for the others' runs has a longer time-out).
 void add_render_options(CLI::App& cmd);
 void add_sweep_options(CLI::App& cmd);
+void add_bench_options(CLI::App& cmd);
 
 // Runs `step` on every process; when it throws on any, it throws on all, naming the first process at
 // fault and its cause (in the plain program: `step` itself).
@@ -54,5 +68,20 @@ std::vector<std::size_t> share(std::size_t count);
 
 // Every process's `mine`, in rank order, on the leader (empty elsewhere).
 std::vector<std::string> gather(const std::string& mine);
+
+// The leader's `leaders` on every process.
+std::string broadcast(const std::string& leaders);
+
+// The results of the runs 0..count-1 on the leader, in run order (empty elsewhere), from each
+// process's results of its share: results[k] is run mine[k]'s, mine = share(count).
+std::vector<std::string> gather_runs(std::size_t count, const std::vector<std::size_t>& mine,
+                                     std::vector<std::string> results);
+
+// A sweep of independent runs 0..count-1, each run whole on one process (its share): `run(i)` returns
+// run i's result, and the leader is handed every result in run order, `take(i, result)`: in one
+// process as each run ends, under MPI once every rank has run its share. A run that throws on any
+// process fails the sweep on all (`together`, named `name`).
+void sweep(std::size_t count, const std::function<std::string(std::size_t)>& run,
+           const std::function<void(std::size_t, const std::string&)>& take, const std::string& name);
 
 }  // namespace cellrt::cli::cluster

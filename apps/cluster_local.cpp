@@ -1,4 +1,4 @@
-// The plain cellrt program's cluster: this one process (cluster.hpp).
+// The plain programs' cluster: this one process (cluster.hpp).
 #include "cluster.hpp"
 
 #include <algorithm>
@@ -7,15 +7,19 @@
 #include <numeric>
 
 namespace cellrt::cli::cluster {
+namespace {
+const char* g_program = "cellrt";
+}  // namespace
 
-void start(int&, char**&) {}
+void start(int&, char**&, const char* program) { g_program = program; }
 int finish(int status) { return status; }
 int rank() { return 0; }
 int ranks() { return 1; }
 unsigned cores() { return std::max(1u, std::thread::hardware_concurrency()); }
-void print_error(const std::exception& e) { std::fprintf(stderr, "cellrt: error: %s\n", e.what()); }
+void print_error(const std::exception& e) { std::fprintf(stderr, "%s: error: %s\n", g_program, e.what()); }
 void add_render_options(CLI::App&) {}
 void add_sweep_options(CLI::App&) {}
+void add_bench_options(CLI::App&) {}
 void together(const std::function<void()>& step, const std::string&) { step(); }
 Scene load_scene(const std::string& spec) { return cellrt::load_scene(spec); }
 
@@ -31,5 +35,16 @@ std::vector<std::size_t> share(std::size_t count) {
 }
 
 std::vector<std::string> gather(const std::string& mine) { return {mine}; }
+std::string broadcast(const std::string& leaders) { return leaders; }
+
+// This process ran every run, in order.
+std::vector<std::string> gather_runs(std::size_t, const std::vector<std::size_t>&, std::vector<std::string> results) {
+    return results;
+}
+
+void sweep(std::size_t count, const std::function<std::string(std::size_t)>& run,
+           const std::function<void(std::size_t, const std::string&)>& take, const std::string&) {
+    for (std::size_t i = 0; i < count; ++i) take(i, run(i));
+}
 
 }  // namespace cellrt::cli::cluster

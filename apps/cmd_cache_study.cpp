@@ -23,6 +23,7 @@
 #include <thread>
 #include <type_traits>
 #include <unistd.h>
+#include <utility>
 
 #include "accel/local_store_registry.hpp"
 #include "cellrt/error.hpp"
@@ -142,20 +143,11 @@ std::vector<Result> trace_shared(const std::map<std::string, std::unique_ptr<Loc
     for (std::size_t i : mine) my_runs.push_back(runs[i]);
     std::vector<Result> my_results;
     cluster::together([&] { my_results = trace_all(bases, my_runs, w, threads); }, "tracing the runs");
-    std::string bytes;
-    for (std::size_t k = 0; k < mine.size(); ++k) {
-        bytes.append(reinterpret_cast<const char*>(&mine[k]), sizeof mine[k]);
-        bytes.append(reinterpret_cast<const char*>(&my_results[k]), sizeof my_results[k]);
-    }
-    const std::vector<std::string> all = cluster::gather(bytes);
-    std::vector<Result> results(cluster::leader() ? runs.size() : 0);
-    for (const std::string& b : all)
-        for (std::size_t at = 0; at + sizeof(std::size_t) + sizeof(Result) <= b.size();
-             at += sizeof(std::size_t) + sizeof(Result)) {
-            std::size_t i;
-            std::memcpy(&i, b.data() + at, sizeof i);
-            std::memcpy(&results.at(i), b.data() + at + sizeof i, sizeof(Result));
-        }
+    std::vector<std::string> bytes;
+    for (const Result& r : my_results) bytes.emplace_back(reinterpret_cast<const char*>(&r), sizeof r);
+    std::vector<Result> results;
+    for (const std::string& b : cluster::gather_runs(runs.size(), mine, std::move(bytes)))
+        std::memcpy(&results.emplace_back(), b.data(), sizeof(Result));
     return results;
 }
 

@@ -11,12 +11,16 @@
 // build's peak memory and the tree's SAH cost); then, after a warm-up pass each,
 // the configurations are traced in turn, `--repeats` rounds (median per ray kind), single-threaded
 // unless `--threads` says otherwise.
+//
+// The unit of work is a scene: its rays, every configuration (Embree's with them) built and timed in
+// turn. cellrt_bench-mpi gives each rank whole scenes and gathers their tables and rows on rank 0, which
+// prints and writes them in the one-process order (bench_cluster.hpp, docs/DISTRIBUTED.md).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <ctime>
 #include <cstdio>
-#include <fstream>
+#include <cstdlib>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -30,6 +34,7 @@
 #define CALLGRIND_STOP_INSTRUMENTATION
 #endif
 
+#include "bench_cluster.hpp"
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
@@ -43,6 +48,7 @@ namespace {
 
 using namespace cellrt;
 using bench::median;
+namespace cluster = cli::cluster;
 
 // The rays every configuration traces: primary rays (closest hit), and rays of a second kind, any hit
 // or closest hit as the kind asks.
@@ -89,7 +95,7 @@ struct Options {
 };
 
 // Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
-// option), as CLI11_PARSE would.
+// option), as CLI11_PARSE would. A bad configuration or size fails on every process (cluster.hpp).
 std::optional<int> parse_options(int argc, char** argv, Options& o) {
     CLI::App app{"cellrt structures vs Embree: build time, memory, Mrays/s on the same rays in the same run"};
     app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
@@ -114,11 +120,16 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
                    "for builds")
         ->capture_default_str()
         ->check(CLI::IsMember({"wall", "cpu"}));
+    cluster::add_bench_options(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return cluster::exit_parse(app, e);
     }
+    cluster::together([&] {
+        for (const std::string& text : o.configs) parse_accel_config(text);
+        if (!o.size.empty()) parse_image_size("--size", o.size);
+    }, "checking the options");
     return std::nullopt;
 }
 
@@ -297,7 +308,7 @@ std::vector<Result> results_of(std::vector<Entry>& entries, const SceneRays& s) 
 
 // The scene's table, with ratios to Embree in this run: builds to its first configuration (its
 // default build), rays per second to rtcIntersect1 (`embree:single`) and to its fastest configuration.
-void print_table(const std::vector<Result>& results, const Rays& rays) {
+void print_table(std::FILE* out, const std::vector<Result>& results, const Rays& rays) {
     const double np = static_cast<double>(rays.primary.size()), ns = static_cast<double>(rays.secondary.size());
     auto total = [&](const Result& r) { return (np + ns) / (r.primary_s + r.shadow_s) * 1e-6; };
     const Result *first = nullptr, *single = nullptr, *best = nullptr;
@@ -308,10 +319,10 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
         if (!best || total(r) > total(*best)) best = &r;
     }
     const char* second = to_string(rays.secondary_kind);
-    std::printf("| config | build ms | build ÷ Embree | build peak MiB | memory MiB | SAH cost | primary Mrays/s | "
+    std::fprintf(out, "| config | build ms | build ÷ Embree | build peak MiB | memory MiB | SAH cost | primary Mrays/s | "
                 "%s Mrays/s | total Mrays/s | × Embree 1 | × Embree best | answers ≠ exact | nodes/leaves/tris per "
                 "primary ray | per %s ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-                second, second);
+                 second, second);
     auto ratio = [](const Result* y, double value, double of_y) {
         if (!y) return std::string("–");
         char buf[32];
@@ -322,15 +333,16 @@ void print_table(const std::vector<Result>& results, const Rays& rays) {
         const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
         char sah[32] = "–";
         if (r.sah_cost > 0) std::snprintf(sah, sizeof sah, "%.2f", r.sah_cost);
-        std::printf("| %s | %.1f | %s | %.1f | %.2f | %s | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | "
-                    "%.1f / %.1f / %.1f |\n",
-                    r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
-                    r.build_peak_mib, r.memory_mib, sah, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
-                    ratio(single, total(r), single ? total(*single) : 1).c_str(),
-                    ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing + r.differing_secondary,
-                    per_ray(pw.nodes, pw),
-                    per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
-                    per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
+        std::fprintf(out,
+                     "| %s | %.1f | %s | %.1f | %.2f | %s | %.2f | %.2f | %.2f | %s | %s | %zu | %.1f / %.1f / %.1f | "
+                     "%.1f / %.1f / %.1f |\n",
+                     r.config.c_str(), r.build_s * 1e3, ratio(first, r.build_s, first ? first->build_s : 1).c_str(),
+                     r.build_peak_mib, r.memory_mib, sah, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
+                     ratio(single, total(r), single ? total(*single) : 1).c_str(),
+                     ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing + r.differing_secondary,
+                     per_ray(pw.nodes, pw),
+                     per_ray(pw.leaves, pw), per_ray(pw.triangles, pw), per_ray(sw.nodes, sw),
+                     per_ray(sw.leaves, sw), per_ray(sw.triangles, sw));
     }
 }
 
@@ -355,37 +367,52 @@ nlohmann::json json_row(const Scene& scene, int width, int height, const Options
                                 {"triangles", per_ray(sw.triangles, sw)}}}};
 }
 
-// One scene: its rays, every configuration built and timed, its table; its JSON rows go to `out`.
-void bench_scene(const Scene& scene, const Options& o, nlohmann::json& out) {
+// One scene: its rays, every configuration built and timed; its table (Markdown) and its JSON rows, as
+// {"table": ..., "rows": [...]}.
+nlohmann::json bench_scene(const Scene& scene, const Options& o) {
     const auto [w, h] = o.size.empty() ? std::pair{scene.width, scene.height} : parse_image_size("--size", o.size);
     const SceneRays s = scene_rays(scene, o, w, h);
-    std::printf("\n### %s: %zu triangles, %dx%d, %s rays: %zu primary + %zu %s\n\n", scene.name.c_str(),
-                scene.triangles.size(), w, h, o.ray_kind.c_str(), s.rays.primary.size(), s.rays.secondary.size(),
-                to_string(s.rays.secondary_kind));
     std::vector<Entry> entries = build_configurations(scene, o);
     CALLGRIND_START_INSTRUMENTATION;
     timed_passes(entries, s.rays, o);
     CALLGRIND_STOP_INSTRUMENTATION;
     const std::vector<Result> results = results_of(entries, s);
     std::fprintf(stderr, "%s done\n", scene.name.c_str());
-    print_table(results, s.rays);
-    for (const Result& r : results) out.push_back(json_row(scene, w, h, o, s.rays, r));
-    std::fflush(stdout);
+    char* text = nullptr;
+    std::size_t length = 0;
+    std::FILE* table = open_memstream(&text, &length);
+    if (!table) throw Error("cannot make the table: out of memory");
+    std::fprintf(table, "\n### %s: %zu triangles, %dx%d, %s rays: %zu primary + %zu %s\n\n", scene.name.c_str(),
+                 scene.triangles.size(), w, h, o.ray_kind.c_str(), s.rays.primary.size(), s.rays.secondary.size(),
+                 to_string(s.rays.secondary_kind));
+    print_table(table, results, s.rays);
+    std::fclose(table);
+    nlohmann::json out{{"table", std::string(text, length)}, {"rows", nlohmann::json::array()}};
+    std::free(text);
+    for (const Result& r : results) out["rows"].push_back(json_row(scene, w, h, o, s.rays, r));
+    return out;
+}
+
+int run(int argc, char** argv) {
+    Options o;
+    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
+    bench::check_results_paths({o.json_path});
+    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes);
+    nlohmann::json out = nlohmann::json::array();
+    // A scene a run: its configurations, Embree's among them, stay together on one process.
+    cluster::sweep(
+        specs.size(), [&](std::size_t i) { return bench_scene(load_scene(specs[i]), o).dump(); },
+        [&](std::size_t, const std::string& result) {
+            const nlohmann::json scene = nlohmann::json::parse(result);
+            std::fputs(scene["table"].get<std::string>().c_str(), stdout);
+            std::fflush(stdout);
+            for (const nlohmann::json& row : scene["rows"]) out.push_back(row);
+        },
+        "benchmarking the scenes");
+    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n");
+    return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    Options o;
-    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-    nlohmann::json out = nlohmann::json::array();
-    try {
-        for (const std::string& name : o.scenes)
-            if (const auto spec = bench::scene_spec(o.scenes_dir, name)) bench_scene(load_scene(*spec), o, out);
-    } catch (const Error& e) {
-        std::fprintf(stderr, "cellrt_bench: error: %s\n", e.what());
-        return 1;
-    }
-    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
-    return 0;
-}
+int main(int argc, char** argv) { return cellrt::bench::main_on_cluster(argc, argv, "cellrt_bench", run); }

@@ -47,12 +47,27 @@ inline double resident_memory_bytes() {
 }
 
 // The scene a benchmark argument names: a builtin:... spec as it is, a shared scene's name as
-// DIR/NAME/NAME.json. A shared scene that is not there is skipped with a message (nullopt).
-inline std::optional<std::string> scene_spec(const std::string& scenes_dir, const std::string& name) {
+// DIR/NAME/NAME.json.
+inline std::string scene_file(const std::string& scenes_dir, const std::string& name) {
     if (name.rfind("builtin:", 0) == 0) return name;
-    const std::string spec = (std::filesystem::path(scenes_dir) / name / (name + ".json")).string();
-    if (std::filesystem::exists(spec)) return spec;
+    return (std::filesystem::path(scenes_dir) / name / (name + ".json")).string();
+}
+
+// Whether the scene `spec` (of scene_file) is there: a builtin one always is.
+inline bool scene_found(const std::string& spec) {
+    return spec.rfind("builtin:", 0) == 0 || std::filesystem::exists(spec);
+}
+
+inline void print_skipped_scene(const std::string& name, const std::string& spec) {
     std::fprintf(stderr, "skipping %s: %s not found\n", name.c_str(), spec.c_str());
+}
+
+// scene_file's spec where the scene is there; a shared scene that is not is skipped with a message
+// (nullopt).
+inline std::optional<std::string> scene_spec(const std::string& scenes_dir, const std::string& name) {
+    std::string spec = scene_file(scenes_dir, name);
+    if (scene_found(spec)) return spec;
+    print_skipped_scene(name, spec);
     return std::nullopt;
 }
 

@@ -10,17 +10,22 @@
 // longer the same packets took with N workers than with one (shared caches and memory, the clock).
 // Writes Markdown tables to stdout and every point as JSON and CSV; bench/plot_scaling.py draws the
 // curves.
+//
+// The unit of work is a scene: every structure (Embree's with them) built and measured for every
+// dispatch mode and packet size. cellrt_scaling-mpi gives each rank whole scenes and gathers their
+// points on rank 0, which prints and writes them in the one-process order (bench_cluster.hpp,
+// docs/DISTRIBUTED.md).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <optional>
-#include <thread>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "bench_cluster.hpp"
 #include "bench_common.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
@@ -33,6 +38,7 @@ namespace {
 
 using namespace cellrt;
 using bench::median;
+namespace cluster = cli::cluster;
 
 struct Point {
     std::string scene, config, dispatch;
@@ -48,6 +54,8 @@ struct Point {
     double packet_time_ratio;  // busy(N) / busy(first): how much longer the same packets took
     std::uint64_t rays;
 };
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(Point, scene, config, dispatch, packet, workers, seconds, busy_seconds,
+                                   started_seconds, waiting_seconds, efficiency, packet_time_ratio, rays)
 
 // The median over rounds r of f(r).
 template <class F>
@@ -73,7 +81,8 @@ struct Options {
 };
 
 // Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
-// option), as CLI11_PARSE would. Throws cellrt::Error for a bad --shading.
+// option), as CLI11_PARSE would. A bad --shading, --size or configuration fails on every process
+// (cluster.hpp).
 std::optional<int> parse_options(int argc, char** argv, Options& o) {
     CLI::App app{"cellrt scaling study: seconds per frame vs workers, dispatch and packet size, Embree alongside"};
     app.add_option("--scenes-dir", o.scenes_dir, "Folder of the shared scenes")->capture_default_str();
@@ -94,7 +103,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--packets", o.packets, "Packet edges P (P x P rays)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPacket));
-    app.add_option("--workers", o.workers, "Worker counts (default 1..cores)");
+    app.add_option("--workers", o.workers, "Worker counts (default 1..cores; under MPI rank 0's cores)");
     app.add_option("--repeats", o.repeats, "Timed frames per point (median)")
         ->capture_default_str()
         ->check(CLI::Range(1, 100));
@@ -113,20 +122,28 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_flag("--pin", o.pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     app.add_option("--csv", o.csv_path, "Write every point as CSV");
     app.add_option("--json", o.json_path, "Write every point as JSON");
+    cluster::add_bench_options(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return cluster::exit_parse(app, e);
     }
-    try {
-        o.shading.shading = parse_shading(shading);
-    } catch (const Error& e) {
-        throw Error("--shading: " + std::string(e.what()));  // the library names the value, the user typed the option
-    }
-    // Another shading casts no AO rays: the rows would record samples that were never taken.
-    if (ao_samples->count() > 0 && o.shading.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
+    cluster::together([&] {
+        try {
+            o.shading.shading = parse_shading(shading);
+        } catch (const Error& e) {
+            // the library names the value, the user typed the option
+            throw Error("--shading: " + std::string(e.what()));
+        }
+        // Another shading casts no AO rays: the rows would record samples that were never taken.
+        if (ao_samples->count() > 0 && o.shading.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
+        parse_image_size("--size", o.size);
+        for (const std::string& text : o.configs) parse_accel_config(text);
+    }, "checking the options");
+    // Every process measures the same worker counts, so that the points are those of one process.
+    const unsigned cores = static_cast<unsigned>(std::stoul(cluster::broadcast(std::to_string(cluster::cores()))));
     if (o.workers.empty())
-        for (unsigned w = 1; w <= std::max(1u, std::thread::hardware_concurrency()); ++w) o.workers.push_back(w);
+        for (unsigned w = 1; w <= cores; ++w) o.workers.push_back(w);
     std::sort(o.workers.begin(), o.workers.end());  // efficiencies are against the fewest
     o.workers.erase(std::unique(o.workers.begin(), o.workers.end()), o.workers.end());
     return std::nullopt;
@@ -210,34 +227,44 @@ struct Study {
     std::vector<std::string> scene_names;
 };
 
-// Every scene, then every structure this binary has, dispatch mode and packet size, in that nesting:
-// each structure is built once and measured for all the dispatch modes and packet sizes.
+// One scene's points: every structure this binary has, dispatch mode and packet size, in that nesting
+// (each structure is built once and measured for all the dispatch modes and packet sizes), as
+// {"scene": its name, "points": [...]}.
+nlohmann::json measure_scene(const Scene& scene, const Options& o) {
+    const auto [width, height] = parse_image_size("--size", o.size);
+    std::vector<Point> points;
+    for (const std::string& cfg_text : o.configs) {
+        const AccelConfig cfg = parse_accel_config(cfg_text);
+        if (!bench::built_in(cfg.kind)) continue;
+        const auto accel = make_accelerator(scene.triangles, cfg);
+        for (const std::string& d : o.dispatches)
+            for (int p : o.packets) {
+                RenderOptions ro;
+                ro.width = width;
+                ro.height = height;
+                ro.packet = p;
+                ro.dispatch = parse_dispatch(d);
+                ro.idle_spin = std::chrono::microseconds(o.idle_spin);
+                ro.pin = o.pin;
+                ro.shading = o.shading;
+                add_points(timed_frames(scene, *accel, ro, o), scene.name, cfg_text, d, p, o, points);
+            }
+    }
+    return {{"scene", scene.name}, {"points", points}};
+}
+
+// Every scene found, a run of the sweep each (bench_cluster.hpp).
 Study measure(const Options& o) {
     Study study;
-    const auto [width, height] = parse_image_size("--size", o.size);
-    for (const std::string& name : o.scenes) {
-        const auto spec = bench::scene_spec(o.scenes_dir, name);
-        if (!spec) continue;
-        const Scene scene = load_scene(*spec);
-        study.scene_names.push_back(scene.name);
-        for (const std::string& cfg_text : o.configs) {
-            const AccelConfig cfg = parse_accel_config(cfg_text);
-            if (!bench::built_in(cfg.kind)) continue;
-            const auto accel = make_accelerator(scene.triangles, cfg);
-            for (const std::string& d : o.dispatches)
-                for (int p : o.packets) {
-                    RenderOptions ro;
-                    ro.width = width;
-                    ro.height = height;
-                    ro.packet = p;
-                    ro.dispatch = parse_dispatch(d);
-                    ro.idle_spin = std::chrono::microseconds(o.idle_spin);
-                    ro.pin = o.pin;
-                    ro.shading = o.shading;
-                    add_points(timed_frames(scene, *accel, ro, o), scene.name, cfg_text, d, p, o, study.points);
-                }
-        }
-    }
+    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes);
+    cluster::sweep(
+        specs.size(), [&](std::size_t i) { return measure_scene(load_scene(specs[i]), o).dump(); },
+        [&](std::size_t, const std::string& result) {
+            const nlohmann::json scene = nlohmann::json::parse(result);
+            study.scene_names.push_back(scene["scene"].get<std::string>());
+            for (const nlohmann::json& point : scene["points"]) study.points.push_back(point.get<Point>());
+        },
+        "measuring the scenes");
     return study;
 }
 
@@ -323,8 +350,8 @@ nlohmann::json points_json(const std::vector<Point>& points, const std::string& 
 }
 
 // The JSON rows as CSV, a column each; ao_samples and embree_seconds are empty where a row lacks them.
-void write_csv(const std::string& path, const nlohmann::json& rows) {
-    std::ofstream csv(path);
+std::string csv_of(const nlohmann::json& rows) {
+    std::ostringstream csv;
     csv << "scene,config,dispatch,packet,shading,ao_samples,workers,seconds,busy_seconds,started_seconds,"
            "waiting_seconds,efficiency,packet_time_ratio,rays,embree_seconds\n";
     for (const auto& j : rows) {
@@ -335,31 +362,29 @@ void write_csv(const std::string& path, const nlohmann::json& rows) {
             << j["started_seconds"] << ',' << j["waiting_seconds"] << ',' << j["efficiency"] << ','
             << j["packet_time_ratio"] << ',' << j["rays"] << ',' << optional("embree_seconds") << '\n';
     }
+    return csv.str();
+}
+
+int run(int argc, char** argv) {
+    Options o;
+    if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
+    bench::check_results_paths({o.json_path, o.csv_path});
+    const std::string yardstick = yardstick_of(o.configs);
+    const Study study = measure(o);
+    // One table per configuration, dispatch and packet size; then where the time of the most workers went.
+    if (cluster::leader())
+        for (const std::string& config : o.configs)
+            for (const std::string& d : o.dispatches)
+                for (int p : o.packets) {
+                    print_seconds_table(study, o, yardstick, config, d, p);
+                    print_time_shares(study, o, config, d, p);
+                }
+    const nlohmann::json out = points_json(study.points, yardstick, o.shading);
+    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n");
+    if (!o.csv_path.empty()) bench::write_results(o.csv_path, csv_of(out));
+    return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    Options o;
-    std::string yardstick;
-    Study study;
-    try {
-        if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-        yardstick = yardstick_of(o.configs);  // parses the configurations: a bad one is the user's error
-        study = measure(o);
-    } catch (const Error& e) {
-        std::fprintf(stderr, "cellrt_scaling: error: %s\n", e.what());
-        return 1;
-    }
-    // One table per configuration, dispatch and packet size; then where the time of the most workers went.
-    for (const std::string& config : o.configs)
-        for (const std::string& d : o.dispatches)
-            for (int p : o.packets) {
-                print_seconds_table(study, o, yardstick, config, d, p);
-                print_time_shares(study, o, config, d, p);
-            }
-    const nlohmann::json out = points_json(study.points, yardstick, o.shading);
-    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
-    if (!o.csv_path.empty()) write_csv(o.csv_path, out);
-    return 0;
-}
+int main(int argc, char** argv) { return cellrt::bench::main_on_cluster(argc, argv, "cellrt_scaling", run); }

@@ -8,7 +8,12 @@ execute_process(COMMAND ${SOURCE}/tools/bundle.sh ${WORK}/bundle OUTPUT_VARIABLE
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "tools/bundle.sh failed (${rc}): ${out}${err}")
 endif()
-foreach(program cellrt cellrt_scaling cellrt_bench)
+# With the MPI programs where they were built, and mpirun with them.
+set(programs cellrt cellrt_scaling cellrt_bench)
+if(EXISTS ${BUILD}/cellrt-mpi)
+  list(APPEND programs cellrt-mpi cellrt_bench-mpi cellrt_scaling-mpi mpirun orted)
+endif()
+foreach(program ${programs})
   if(NOT EXISTS ${WORK}/bundle/bin/${program})
     message(FATAL_ERROR "the bundle lacks ${program}")
   endif()
@@ -28,7 +33,7 @@ if(NOT rc EQUAL 0 OR at EQUAL -1)
 endif()
 # ... and with the bundle's library folder on the path (as `run` sets it), every library the programs
 # load is the bundle's or a runtime one.
-foreach(program cellrt cellrt_scaling cellrt_bench)
+foreach(program ${programs})
   execute_process(COMMAND ${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${WORK}/bundle/lib ldd ${WORK}/bundle/bin/${program}
                   OUTPUT_VARIABLE deps RESULT_VARIABLE rc)
   string(REGEX MATCHALL "=> /[^ ]+" resolved "${deps}")
@@ -43,6 +48,38 @@ foreach(program cellrt cellrt_scaling cellrt_bench)
     message(FATAL_ERROR "${program} from the bundle misses a library:\n${deps}")
   endif()
 endforeach()
+
+# The bundle's mpirun runs its cellrt-mpi: a frame over 2 ranks, the plain program's bytes. Where this
+# machine allows a private mount namespace (root), the installed Open MPI's components, help texts,
+# settings and PMIx are covered by an empty folder there, so that only the bundle's can be found.
+if(EXISTS ${BUILD}/cellrt-mpi)
+  set(frame builtin:city?tris=300 --size 32x24 -o)
+  execute_process(COMMAND ${WORK}/bundle/run cellrt render ${frame} ${WORK}/plain.pfm RESULT_VARIABLE rc)
+  file(WRITE ${WORK}/hidden.sh [=[
+set -e
+mkdir -p "$EMPTY"
+dirs="$(ompi_info --path all --parsable | sed -n 's/^path:\(pkglibdir\|pkgdatadir\|sysconfdir\)://p' | sort -u)"
+pmix="$(ompi_info --config --parsable | grep -o "'--with-pmix=[^']*'" | sed "s/'--with-pmix=\(.*\)'/\1/")"
+for d in $dirs $pmix; do mount --bind "$EMPTY" "$d"; done
+exec "$@"
+]=])
+  set(mpirun ${WORK}/bundle/run mpirun --allow-run-as-root --oversubscribe -np 2 cellrt-mpi render ${frame} ${WORK}/mpi.pfm)
+  execute_process(COMMAND unshare -m true RESULT_VARIABLE private OUTPUT_QUIET ERROR_QUIET)
+  if(private EQUAL 0)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E env EMPTY=${WORK}/empty unshare -m sh ${WORK}/hidden.sh ${mpirun}
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  else()
+    message(STATUS "no private mount namespace here: the bundle's mpirun runs beside the installed Open MPI")
+    execute_process(COMMAND ${mpirun} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  endif()
+  file(READ ${WORK}/plain.pfm plain HEX)
+  if(EXISTS ${WORK}/mpi.pfm)
+    file(READ ${WORK}/mpi.pfm mpi HEX)
+  endif()
+  if(NOT rc EQUAL 0 OR NOT plain STREQUAL mpi)
+    message(FATAL_ERROR "the bundle's mpirun with cellrt-mpi failed (${rc}) or drew another frame: ${out}${err}")
+  endif()
+endif()
 
 execute_process(COMMAND ${WORK}/bundle/run no_such_program RESULT_VARIABLE rc ERROR_VARIABLE err)
 if(rc EQUAL 0)

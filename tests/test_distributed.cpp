@@ -1,10 +1,13 @@
 // cellrt-mpi under mpirun (docs/DISTRIBUTED.md): frames byte for byte those of the plain program for
 // 1, 2 and 3 ranks, every shading and several structures, tile and packet sizes; a cache study split
-// over ranks writes the plain program's results; a rank whose scene fails, a rank that dies, one that
-// stops answering and a bad option each end every rank with a non-zero status, one message naming the
-// rank and the cause, and no output file. Skipped where MPI was not found.
+// over ranks writes the plain program's results, and so do the benchmarks' sweeps (cellrt_bench-mpi,
+// cellrt_scaling-mpi); a rank whose scene fails, a rank that dies, one that stops answering and a bad
+// option each end every rank with a non-zero status, one message naming the rank and the cause, and no
+// output file. Skipped where MPI was not found.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +18,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <vector>
+
+#include "cellrt/accel.hpp"
 
 namespace cellrt {
 namespace {
@@ -127,15 +132,131 @@ TEST_F(Distributed, CacheStudySplitOverRanksWritesTheOneProcessResults) {
     }
 }
 
-// A failure: a non-zero status, one error line naming `rank` and holding `cause`, no output file.
-void expect_failure(const Outcome& o, const fs::path& out, const std::string& rank, const std::string& cause) {
+// A failure of `program`: a non-zero status, one error line naming `rank` and holding `cause`, no
+// output file, nor a temporary one beside it.
+void expect_failure(const Outcome& o, const fs::path& out, const std::string& rank, const std::string& cause,
+                    const std::string& program = "cellrt") {
     EXPECT_NE(o.status, 0) << o.err;
-    EXPECT_EQ(count(o.err, "cellrt: error:"), 1u) << o.err;
-    EXPECT_NE(o.err.find("cellrt: error: " + rank), std::string::npos) << o.err;
+    EXPECT_EQ(count(o.err, program + ": error:"), 1u) << o.err;
+    EXPECT_NE(o.err.find(program + ": error: " + rank), std::string::npos) << o.err;
     EXPECT_NE(o.err.find(cause), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(out));
     for (const auto& entry : fs::directory_iterator(out.parent_path()))
-        EXPECT_EQ(entry.path().filename().string().find("frame"), std::string::npos) << entry.path();
+        EXPECT_EQ(entry.path().filename().string().find(out.stem().string()), std::string::npos) << entry.path();
+}
+
+// The benchmarks' sweeps: the same programs as the plain ones, split over the ranks a scene at a time.
+class DistributedBench : public Distributed {
+protected:
+    void SetUp() override {
+        Distributed::SetUp();
+        if (!std::string(CELLRT_MPI_BENCH_SKIP).empty()) GTEST_SKIP() << CELLRT_MPI_BENCH_SKIP;
+        write_scene(scenes, "tiny.obj");
+        std::ofstream(scenes / "tiny" / "tiny.obj")
+            << "v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+               "v -1 2 -1\nv 1 2 -1\nv 1 2 1\nv -1 2 1\n"
+               "f 1 3 2\nf 1 4 3\nf 9 10 11\nf 9 11 12\nf 5 6 10\nf 5 10 9\nf 6 7 11\nf 6 11 10\n"
+               "f 7 8 12\nf 7 12 11\nf 8 5 9\nf 8 9 12\n";
+    }
+    // A small scene from a file, laid out as the shared scenes are (FOLDER/NAME/NAME.json) and read
+    // from `mesh` (SetUp writes tiny.obj: a ground quad and a box over it).
+    static void write_scene(const fs::path& folder, const std::string& mesh) {
+        fs::create_directories(folder / "tiny");
+        std::ofstream(folder / "tiny" / "tiny.json")
+            << R"({"name": "tiny", "mesh": ")" << mesh << R"(",
+                  "camera": {"position": [5, 4, 6], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov_y_deg": 45},
+                  "light": {"type": "point", "position": [-2, 8, 7], "color": [1, 1, 1]},
+                  "image": {"width": 64, "height": 48}})";
+    }
+    fs::path scenes = dir.path / "scenes";
+    // Three scenes, so that 2 and 3 ranks each get a share, one of them two scenes.
+    std::string sweep() const {
+        return " --scenes-dir " + scenes.string() +
+               " --scenes 'builtin:city?tris=300&seed=3' tiny 'builtin:forest?tris=300' --size 32x24";
+    }
+};
+
+// 1 where this build has Embree: the programs skip its configurations where it has not.
+std::size_t embree_configs() {
+    const std::vector<std::string> kinds = accelerator_kinds();
+    return static_cast<std::size_t>(std::count(kinds.begin(), kinds.end(), "embree"));
+}
+
+// The JSON rows without the fields measured by a clock or from the process's memory.
+nlohmann::json without_measurements(const std::string& text, const std::vector<std::string>& measured) {
+    nlohmann::json rows = nlohmann::json::parse(text);
+    for (nlohmann::json& row : rows)
+        for (const std::string& key : measured) row.erase(key);
+    return rows;
+}
+
+// The plain program's JSON, then the -mpi program's over 2 and 3 ranks, the same rows in the same
+// order but for the measured fields.
+void expect_same_sweep(const std::string& plain, const std::string& mpi, const std::string& options,
+                       const std::vector<std::string>& measured, std::size_t rows, const fs::path& dir) {
+    const fs::path reference = dir / "plain.json";
+    const Outcome p = shell(plain + options + " --json " + reference.string(), dir);
+    ASSERT_EQ(p.status, 0) << p.err;
+    const nlohmann::json expected = without_measurements(read(reference), measured);
+    EXPECT_EQ(expected.size(), rows) << expected.dump(1);
+    for (int ranks : {2, 3}) {
+        const fs::path out = dir / ("mpi" + std::to_string(ranks) + ".json");
+        const Outcome o = shell(mpirun(ranks) + mpi + options + " --json " + out.string(), dir);
+        ASSERT_EQ(o.status, 0) << o.err;
+        EXPECT_EQ(without_measurements(read(out), measured), expected) << ranks << " ranks";
+    }
+}
+
+TEST_F(DistributedBench, StructureSweepSplitOverRanksWritesTheOneProcessResults) {
+    expect_same_sweep(CELLRT_BENCH, CELLRT_BENCH_MPI,
+                      sweep() + " --configs embree:single kd:branched bih+auto --repeats 1 --builds 1",
+                      {"build_seconds", "build_peak_mib", "primary_seconds", "shadow_seconds"},
+                      3 * (2 + embree_configs()), dir.path);
+}
+
+TEST_F(DistributedBench, ScalingSweepSplitOverRanksWritesTheOneProcessResults) {
+    expect_same_sweep(CELLRT_SCALING, CELLRT_SCALING_MPI,
+                      sweep() + " --configs embree:single kd+auto --dispatch pull --packets 8 --workers 1 2 --repeats 1",
+                      {"seconds", "busy_seconds", "started_seconds", "waiting_seconds", "efficiency",
+                       "packet_time_ratio", "embree_seconds"},
+                      3 * 2 * (1 + embree_configs()), dir.path);
+}
+
+TEST_F(DistributedBench, ARankWithoutTheScenesEndsEveryRank) {
+    const fs::path out = dir.path / "results.json";
+    const std::string options = " --scenes tiny --size 32x24 --repeats 1 --builds 1 --json " + out.string();
+    // Ranks 1 and 2 are given a scenes folder that lacks the scene (mpirun's MPMD form).
+    const Outcome o = shell(mpirun(1) + CELLRT_BENCH_MPI + " --scenes-dir " + scenes.string() + options + " : -np 2 " +
+                                CELLRT_BENCH_MPI + " --scenes-dir " + (dir.path / "none").string() + options,
+                            dir.path);
+    expect_failure(o, out, "rank 1: ", "scene tiny: " + (dir.path / "none").string() + "/tiny/tiny.json not found, "
+                   "which rank 0 has", "cellrt_bench");
+    EXPECT_NE(o.err.find("(and 1 other rank)"), std::string::npos) << o.err;
+}
+
+TEST_F(DistributedBench, ARankWhoseRunFailsEndsEveryRank) {
+    const fs::path out = dir.path / "results.json";
+    // Rank 1's copy of the second scene names a mesh it does not have; rank 1 is given that scene.
+    write_scene(dir.path / "broken", "gone.obj");
+    const std::string options = " --scenes 'builtin:city?tris=300' tiny --configs kd --packets 8 --workers 1 "
+                                "--repeats 1 --size 32x24 --json " + out.string();
+    const Outcome o = shell(mpirun(1) + CELLRT_SCALING_MPI + " --scenes-dir " + scenes.string() + options +
+                                " : -np 1 " + CELLRT_SCALING_MPI + " --scenes-dir " + (dir.path / "broken").string() +
+                                options,
+                            dir.path);
+    expect_failure(o, out, "rank 1: ", "gone.obj", "cellrt_scaling");
+}
+
+TEST_F(DistributedBench, ABadOptionIsOneMessage) {
+    const fs::path out = dir.path / "results.json";
+    expect_failure(shell(mpirun(3) + CELLRT_SCALING_MPI + " --shading glossy --json " + out.string(), dir.path), out,
+                   "rank 0: ", "--shading: ", "cellrt_scaling");
+    expect_failure(shell(mpirun(2) + CELLRT_BENCH_MPI + " --size 12 --json " + out.string(), dir.path), out,
+                   "rank 0: ", "--size '12' must be WIDTHxHEIGHT", "cellrt_bench");
+    // A results file in a folder that is not there: refused before any run.
+    const fs::path lost = dir.path / "missing" / "results.json";
+    expect_failure(shell(mpirun(2) + CELLRT_SCALING_MPI + " --json " + lost.string(), dir.path), out, "rank 0: ",
+                   lost.string() + ": folder '" + lost.parent_path().string() + "' does not exist", "cellrt_scaling");
 }
 
 TEST_F(Distributed, ARankWhoseSceneFailsEndsEveryRank) {

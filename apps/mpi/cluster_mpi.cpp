@@ -3,8 +3,11 @@
 // fail.
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
+#include <utility>
 
 #include "cluster.hpp"
 #include "distributed/scene_transfer.hpp"
@@ -24,21 +27,33 @@ Options g_options;
 
 distributed::Session& session() { return *g_session; }
 
-void add_common_options(CLI::App& cmd) {
-    cmd.add_flag("--broadcast-scene", g_options.broadcast_scene,
-                 "Rank 0 loads the scene and sends its triangles to the other ranks (default: every rank loads it "
-                 "from its path)");
+// The longest time-out, a day, and a benchmark's default: a benchmark rank waits for the others' runs at
+// the end of its sweep as long as the longest share of runs lasts (a full sweep of the shared scenes
+// runs for hours on one machine).
+constexpr std::chrono::seconds kLongestRankTimeout{86400};
+
+void add_timeout_option(CLI::App& cmd, std::chrono::seconds fallback) {
+    session().set_timeout(fallback);
     cmd.add_option_function<double>(
            "--rank-timeout",
            [](double s) { session().set_timeout(std::chrono::milliseconds(static_cast<long long>(s * 1e3))); },
            "Seconds a rank waits for another before it ends the job with a message (default " +
-               std::to_string(distributed::kDefaultRankTimeout.count()) + ")")
-        ->check(CLI::Range(0.1, 86400.0));
+               std::to_string(fallback.count()) + ")")
+        ->check(CLI::Range(0.1, static_cast<double>(kLongestRankTimeout.count())));
+}
+
+void add_common_options(CLI::App& cmd) {
+    cmd.add_flag("--broadcast-scene", g_options.broadcast_scene,
+                 "Rank 0 loads the scene and sends its triangles to the other ranks (default: every rank loads it "
+                 "from its path)");
+    add_timeout_option(cmd, distributed::kDefaultRankTimeout);
 }
 
 }  // namespace
 
-void start(int& argc, char**& argv) { g_session = std::make_unique<distributed::Session>(argc, argv); }
+void start(int& argc, char**& argv, const char* program) {
+    g_session = std::make_unique<distributed::Session>(argc, argv, program);
+}
 
 int finish(int status) {
     const int agreed = session().finish(status);
@@ -52,9 +67,9 @@ unsigned cores() { return distributed::rank_threads(0); }
 
 void print_error(const std::exception& e) {
     if (dynamic_cast<const distributed::AgreedError*>(&e)) {
-        if (leader()) std::fprintf(stderr, "cellrt: error: %s\n", e.what());
+        if (leader()) std::fprintf(stderr, "%s: error: %s\n", session().program().c_str(), e.what());
     } else {
-        std::fprintf(stderr, "cellrt: error: rank %d: %s\n", rank(), e.what());
+        std::fprintf(stderr, "%s: error: rank %d: %s\n", session().program().c_str(), rank(), e.what());
     }
 }
 
@@ -70,6 +85,7 @@ void add_render_options(CLI::App& cmd) {
 }
 
 void add_sweep_options(CLI::App& cmd) { add_common_options(cmd); }
+void add_bench_options(CLI::App& cmd) { add_timeout_option(cmd, kLongestRankTimeout); }
 
 void together(const std::function<void()>& step, const std::string& name) { session().together(step, name); }
 
@@ -108,5 +124,44 @@ std::vector<std::size_t> share(std::size_t count) {
 }
 
 std::vector<std::string> gather(const std::string& mine) { return session().gather(mine, "the runs' results"); }
+
+std::string broadcast(const std::string& leaders) {
+    std::uint64_t length = leaders.size();
+    session().broadcast(&length, sizeof length, "rank 0's word");
+    std::string bytes = leaders;
+    bytes.resize(length);
+    session().broadcast(bytes.data(), bytes.size(), "rank 0's word");
+    return bytes;
+}
+
+// Each result travels as its run's index, its length and its bytes.
+std::vector<std::string> gather_runs(std::size_t count, const std::vector<std::size_t>& mine,
+                                     std::vector<std::string> results) {
+    std::string bytes;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+        const std::uint64_t head[2] = {mine[k], results[k].size()};
+        bytes.append(reinterpret_cast<const char*>(head), sizeof head);
+        bytes += results[k];
+    }
+    std::vector<std::string> all(leader() ? count : 0);
+    for (const std::string& b : gather(bytes))
+        for (std::size_t at = 0; at < b.size();) {
+            std::uint64_t head[2];
+            std::memcpy(head, b.data() + at, sizeof head);
+            at += sizeof head;
+            all.at(head[0]) = b.substr(at, head[1]);
+            at += head[1];
+        }
+    return all;
+}
+
+void sweep(std::size_t count, const std::function<std::string(std::size_t)>& run,
+           const std::function<void(std::size_t, const std::string&)>& take, const std::string& name) {
+    const std::vector<std::size_t> mine = share(count);
+    std::vector<std::string> results;
+    together([&] { for (std::size_t i : mine) results.push_back(run(i)); }, name);
+    const std::vector<std::string> all = gather_runs(count, mine, std::move(results));
+    for (std::size_t i = 0; i < all.size(); ++i) take(i, all[i]);
+}
 
 }  // namespace cellrt::cli::cluster

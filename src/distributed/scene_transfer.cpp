@@ -1,6 +1,5 @@
 #include "distributed/scene_transfer.hpp"
 
-#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <type_traits>
@@ -37,17 +36,6 @@ struct SceneHeader {
 };
 static_assert(std::is_trivially_copyable_v<SceneHeader> && std::is_trivially_copyable_v<Triangle>);
 
-void broadcast_bytes(const Session& session, void* data, std::size_t n, const std::string& what) {
-    constexpr std::size_t kChunk = std::size_t{1} << 30;  // MPI counts in int
-    auto* p = static_cast<char*>(data);
-    for (std::size_t at = 0; at < n; at += kChunk) {
-        const auto count = static_cast<int>(std::min(kChunk, n - at));
-        MPI_Request request;
-        MPI_Ibcast(p + at, count, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
-        session.wait(request, what);
-    }
-}
-
 }  // namespace
 
 std::uint64_t scene_fingerprint(const Scene& scene) {
@@ -63,7 +51,7 @@ std::uint64_t scene_fingerprint(const Scene& scene) {
 
 void broadcast_scene(const Session& session, Scene& scene) {
     SceneHeader header{scene.camera, scene.light, scene.width, scene.height, scene.name.size(), scene.triangles.size()};
-    broadcast_bytes(session, &header, sizeof header, "the scene's broadcast");
+    session.broadcast(&header, sizeof header, "the scene's broadcast");
     if (!session.leader()) {
         scene = Scene{};
         scene.camera = header.camera;
@@ -73,9 +61,9 @@ void broadcast_scene(const Session& session, Scene& scene) {
         scene.name.resize(header.name_bytes);
         scene.triangles.resize(header.triangles);
     }
-    broadcast_bytes(session, scene.name.data(), scene.name.size(), "the scene's broadcast");
-    broadcast_bytes(session, scene.triangles.data(), scene.triangles.size() * sizeof(Triangle),
-                    "the scene's broadcast");
+    session.broadcast(scene.name.data(), scene.name.size(), "the scene's broadcast");
+    session.broadcast(scene.triangles.data(), scene.triangles.size() * sizeof(Triangle),
+                      "the scene's broadcast");
 }
 
 void check_same_scene(const Session& session, const Scene& scene) {

@@ -6,13 +6,14 @@
 #include <limits>
 #include <new>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/timer.hpp"
 
 namespace cellrt::distributed {
 
-Session::Session(int& argc, char**& argv) {
+Session::Session(int& argc, char**& argv, std::string program) : program_(std::move(program)) {
     int provided = 0;
     MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -56,7 +57,7 @@ void Session::wait(MPI_Request& request, const std::string& what) const {
 }
 
 void Session::abort(const std::string& message) const {
-    std::fprintf(stderr, "cellrt: error: rank %d: %s\n", rank_, message.c_str());
+    std::fprintf(stderr, "%s: error: rank %d: %s\n", program_.c_str(), rank_, message.c_str());
     std::fflush(stderr);
     if (leader()) {
         static const char word = 0;
@@ -103,6 +104,17 @@ void Session::together(const std::function<void()>& step, const std::string& nam
         failure = e.what();
     }
     agree(failure, name);
+}
+
+void Session::broadcast(void* data, std::size_t n, const std::string& what) const {
+    constexpr std::size_t kChunk = std::size_t{1} << 30;  // MPI counts in int
+    auto* p = static_cast<char*>(data);
+    for (std::size_t at = 0; at < n; at += kChunk) {
+        const auto count = static_cast<int>(std::min(kChunk, n - at));
+        MPI_Request request;
+        MPI_Ibcast(p + at, count, MPI_BYTE, 0, MPI_COMM_WORLD, &request);
+        wait(request, what);
+    }
 }
 
 std::vector<std::string> Session::gather(const std::string& mine, const std::string& what) const {

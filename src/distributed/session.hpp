@@ -34,8 +34,9 @@ inline constexpr std::chrono::microseconds kPollInterval{500};
 
 class Session {
 public:
-    // MPI_Init_thread; throws cellrt::Error when MPI cannot give MPI_THREAD_FUNNELED.
-    Session(int& argc, char**& argv);
+    // MPI_Init_thread; throws cellrt::Error when MPI cannot give MPI_THREAD_FUNNELED. `program` names
+    // the program in the messages the session prints ("cellrt: error: ...").
+    Session(int& argc, char**& argv, std::string program);
     ~Session();  // MPI_Finalize
     Session(const Session&) = delete;
     Session& operator=(const Session&) = delete;
@@ -43,6 +44,7 @@ public:
     int rank() const { return rank_; }
     int size() const { return size_; }
     bool leader() const { return rank_ == 0; }
+    const std::string& program() const { return program_; }
 
     std::chrono::milliseconds timeout() const { return timeout_; }
     void set_timeout(std::chrono::milliseconds t) { timeout_ = t; }
@@ -52,11 +54,11 @@ public:
 
     // Polls `request` until it completes. When it has not within the time-out (on ranks other than 0
     // twice the time-out, so that rank 0, which knows which rank is missing, speaks first), prints
-    // "cellrt: error: rank R: no answer to WHAT within T s" and aborts the job (MPI_Abort: a rank that
+    // "PROGRAM: error: rank R: no answer to WHAT within T s" and aborts the job (MPI_Abort: a rank that
     // stopped answering cannot take part in an orderly end).
     void wait(MPI_Request& request, const std::string& what) const;
 
-    // Prints "cellrt: error: rank R: MESSAGE" and ends the whole job with status 1. Rank 0 first tells
+    // Prints "PROGRAM: error: rank R: MESSAGE" and ends the whole job with status 1. Rank 0 first tells
     // the others, which then end at their next wait without a message of their own.
     [[noreturn]] void abort(const std::string& message) const;
 
@@ -68,6 +70,9 @@ public:
     // AgreedError of all.
     void together(const std::function<void()>& step, const std::string& name) const;
 
+    // Rank 0's `n` bytes at `data` into every rank's (n the same on all), in chunks MPI can count.
+    void broadcast(void* data, std::size_t n, const std::string& what) const;
+
     // Every rank's `mine`, in rank order, on rank 0 (the others get an empty list).
     std::vector<std::string> gather(const std::string& mine, const std::string& what) const;
 
@@ -75,6 +80,7 @@ public:
     int finish(int status) const;
 
 private:
+    std::string program_;
     int rank_ = 0, size_ = 1;
     std::chrono::milliseconds timeout_ = kDefaultRankTimeout;
 };
