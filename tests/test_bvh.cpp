@@ -203,5 +203,63 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
     EXPECT_EQ(detail::batch_coherence({}), 1.f);
 }
 
+// The measured route: the prior until a sample is in, then the path with the smaller time over the
+// samples; every batch sampled while it learns, few once it knows, fewer when the choice is clear.
+TEST(Routed, PickerTakesThePathThatTookLessTime) {
+    using detail::RoutePicker;
+    RoutePicker picker;
+    const RoutePicker::Choice warm = picker.pick(1);
+    EXPECT_EQ(warm.path, 1);
+    EXPECT_TRUE(warm.sampled);
+    EXPECT_FALSE(warm.counts);
+    EXPECT_EQ(picker.pick(0).path, 0);  // nothing recorded yet: the prior
+    for (int i = 0; i < 16; ++i) picker.record(2.0, 1.0);
+    for (int i = 0; i < 8; ++i) {
+        EXPECT_EQ(picker.pick(0).path, 1);
+        EXPECT_EQ(picker.pick(1).path, 1);
+    }
+    // A preempted batch counts at most kClamp times the other path's time: 34 against 16 + 8 * 2 = 32,
+    // still the BVH (unclamped, 34 against 56).
+    picker.record(2.0, 40.0);
+    EXPECT_EQ(picker.pick(0).path, 1);
+    for (int i = 0; i < 20; ++i) picker.record(1.0, 3.0);
+    EXPECT_EQ(picker.pick(1).path, 0);
+}
+
+TEST(Routed, PickerSamplesFewBatchesOnceItKnows) {
+    using detail::RoutePicker;
+    auto sampled = [](RoutePicker& p, int n) {
+        int s = 0;
+        for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
+        return s;
+    };
+    RoutePicker learning;
+    EXPECT_NEAR(sampled(learning, 8000), 8000 / RoutePicker::kLearn, 8000 / RoutePicker::kLearn / 4);
+    RoutePicker close, clear;
+    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
+        close.record(1.0, 1.2);
+        clear.record(1.0, 3.0);
+    }
+    EXPECT_NEAR(sampled(close, 64000), 64000 / RoutePicker::kSample, 64000 / RoutePicker::kSample / 4);
+    EXPECT_NEAR(sampled(clear, 512000), 512000 / RoutePicker::kSampleFar, 512000 / RoutePicker::kSampleFar / 4);
+}
+
+// Measured or not, the route changes no answer, and the work counted is that of the path that
+// answered (a sampled batch's second tracing is not counted).
+TEST(Routed, MeasuredRouteCountsOneTracingPerRay) {
+    const Scene& scene = test::cached_scene("builtin:city?tris=5000");
+    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto"));
+    const auto exact = make_accelerator(scene.triangles, AccelConfig{"bvh"});
+    const FrameRays frame = frame_rays(scene, 64, 64, 16, *exact);
+    std::vector<Hit> hits(frame.primary.size()), expected(frame.primary.size());
+    exact->intersect(frame.primary, expected);
+    TraversalCounters counters;
+    for (const FrameRays::Packet& p : frame.packets)
+        routed->intersect(std::span(frame.primary).subspan(p.primary, p.primary_count),
+                          std::span(hits).subspan(p.primary, p.primary_count), &counters);
+    EXPECT_EQ(hits, expected);
+    EXPECT_EQ(counters.rays, frame.primary.size());
+}
+
 }  // namespace
 }  // namespace cellrt

@@ -144,7 +144,14 @@ TEST(Params, TablesListEveryTraversalTheStructuresOffer) {
             AccelConfig c;
             c.kind = kind;
             c.traversal = t;
-            EXPECT_NO_THROW(make_accelerator(small_scene(), c)) << kind << ":" << t;
+            try {
+                make_accelerator(small_scene(), c);
+            } catch (const Error& e) {
+                // Embree's packet widths are the processor's: a width it lacks (16 without AVX-512)
+                // is refused, saying so, and is no defect of the table.
+                const bool missing_width = kind == "embree" && std::string(e.what()).find("needs native") != std::string::npos;
+                EXPECT_TRUE(missing_width) << kind << ":" << t << ": " << e.what();
+            }
         }
 }
 

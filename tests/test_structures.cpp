@@ -28,7 +28,8 @@ namespace {
 // the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
-                                    "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih"};
+                                    "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih",
+                                    "auto@route=coherence"};
     for (detail::Isa isa : detail::available_isas())
         for (const char* kind : {"kd", "bih", "bvh"}) out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;

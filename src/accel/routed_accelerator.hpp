@@ -1,10 +1,13 @@
 // `--accel auto`: cellrt's fastest exact path for a mix of coherent and incoherent batches. It holds
-// two exact structures, SIMD packets over a study tree for coherent batches (a frame's primary rays,
-// shadow rays toward one light) and the wide BVH for incoherent ones (diffuse bounces, AO, random
-// queries), and routes each batch by its measured coherence (docs/BVH.md). Both return the brute-force
-// hits, so the answers, and images, do not depend on the route.
+// two exact structures, SIMD packets over a study tree (fastest on coherent batches: a frame's primary
+// rays, shadow rays toward one light) and the wide BVH (fastest on incoherent ones: diffuse bounces,
+// AO, random queries), and routes each batch by its coherence and by the time per ray each path has
+// taken on batches of its kind (docs/BVH.md). Both return the brute-force hits, so the answers, and
+// images, do not depend on the route.
 #pragma once
 
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <span>
 
@@ -16,6 +19,57 @@ namespace cellrt::detail {
 std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, const AccelConfig& config);
 const ParamTable& routed_params();
 const std::vector<std::string>& routed_traversals();
+
+// Which of the two paths traces the next batch of one kind (closest or any hit, coherent or not): the
+// one that has taken less time on the batches of that kind that both have traced. Both paths are exact,
+// so a batch can be traced by both, with the same answers: a sampled batch is, and the two times are a
+// paired sample, free of the spread between batches (a tile of background against one of the object
+// is a factor of ten, more than the two paths differ). The first batch is traced by both to warm
+// their caches, not counted; then one batch in kLearn is sampled until kLearned samples are in, one in
+// kSample after that (one in kSampleFar while one path has taken more than kFar times the other's
+// time, so that a clear choice costs little), picked by a hash of the batch's number rather than
+// every n-th (which would sample the same column of tiles of a frame). A sample's dearer time counts at most kClamp times the
+// cheaper one, so that a batch whose thread the system preempted (milliseconds, on a batch of tens of
+// microseconds) cannot outweigh the others. Before any sample, coherence's choice (the prior) goes. Counts are atomics: any number of threads route and record at once, and a race only blurs a
+// figure. The choice changes only the time, never an answer.
+class RoutePicker {
+public:
+    static constexpr std::uint64_t kLearn = 8, kLearned = 16, kSample = 64, kSampleFar = 512;
+    static constexpr double kClamp = 8.0, kFar = 1.5;
+
+    struct Choice {
+        int path;      // 0: the packets, 1: the BVH
+        bool sampled;  // trace the batch on both paths and record their times
+        bool counts;   // whether the sample is recorded (not the first, which warms up)
+    };
+
+    Choice pick(int prior) {
+        const std::uint64_t n = batches_.fetch_add(1, std::memory_order_relaxed);
+        const double t0 = seconds_[0].load(std::memory_order_relaxed), t1 = seconds_[1].load(std::memory_order_relaxed);
+        const int fast = t0 == t1 ? prior : (t0 < t1 ? 0 : 1);
+        if (n == 0) return {fast, true, false};
+        const bool far = fast == 0 ? t1 > kFar * t0 : t0 > kFar * t1;
+        const std::uint64_t period =
+            samples_.load(std::memory_order_relaxed) < kLearned ? kLearn : (far ? kSampleFar : kSample);
+        return {fast, (n * 0x9e3779b97f4a7c15ull >> 40) % period == 0, true};
+    }
+    void record(double seconds0, double seconds1) {
+        const double bound = kClamp * (seconds0 < seconds1 ? seconds0 : seconds1);
+        add(seconds_[0], seconds0 < bound ? seconds0 : bound);
+        add(seconds_[1], seconds1 < bound ? seconds1 : bound);
+        samples_.fetch_add(1, std::memory_order_relaxed);
+    }
+
+private:
+    static void add(std::atomic<double>& sum, double x) {
+        for (double old = sum.load(std::memory_order_relaxed);
+             !sum.compare_exchange_weak(old, old + x, std::memory_order_relaxed);) {
+        }
+    }
+
+    std::atomic<std::uint64_t> batches_{0}, samples_{0};
+    std::atomic<double> seconds_[2]{0.0, 0.0};  // over the recorded samples, per path
+};
 
 // The batch's coherence: the mean cosine between the directions of neighbouring rays, over up to 64
 // evenly spaced pairs (1 for parallel rays, about 0 for directions uniform on the sphere). Invalid
