@@ -116,10 +116,10 @@ struct Bounds {
     }
     void take_last(const Item& t) {
         const F4 l = lo_of(t), h = hi_of(t), c = (l + h) * 0.5f;
-        lo = l <= lo ? l : lo;
-        hi = hi <= h ? h : hi;
-        centre_lo = c <= centre_lo ? c : centre_lo;
-        centre_hi = centre_hi <= c ? c : centre_hi;
+        lo = lo < l ? lo : l;
+        hi = h < hi ? hi : h;
+        centre_lo = centre_lo < c ? centre_lo : c;
+        centre_hi = c < centre_hi ? centre_hi : c;
     }
     void store(Range& r) const {
         r.centres = {{centre_lo[0], centre_lo[1], centre_lo[2]}, {centre_hi[0], centre_hi[1], centre_hi[2]}};
