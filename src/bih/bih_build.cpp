@@ -18,9 +18,11 @@
 //
 // Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
 // known in advance. The builder reorders records of box and triangle index in place, read in order
-// (no indirection): per node one pass bins all three axes, one partitions, and one bounds the two
-// children's centres and boxes, which their own decisions then need. Large ranges are built as
-// parallel tasks (kernel/subtree.hpp keeps the layout independent of the thread count).
+// (no indirection): per node one pass bins all three axes (the SAH's centre bins computed for the
+// three at once, in four-float vectors), and one partitions the range and bounds the two children's
+// centres and boxes, which their own decisions then need; the cost sweeps visit non-empty bins only.
+// Large ranges are built as parallel tasks (kernel/subtree.hpp keeps the layout independent of the
+// thread count), and the largest are also binned by several threads in blocks combined in order.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -28,7 +30,10 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
+#include <vector>
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -39,6 +44,8 @@ namespace cellrt::detail {
 namespace {
 
 constexpr std::size_t kParallelMin = 4096;
+// Ranges binned by several threads (BihBuildParams::parallel_pass_min) are cut in blocks of this many.
+constexpr std::size_t kBlock = 16384;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The SAH's bins per axis (its costs and largest leaf are parameters: BihBuildParams).
@@ -124,6 +131,42 @@ struct Bounds {
     void store(Range& r) const {
         r.centres = {{centre_lo[0], centre_lo[1], centre_lo[2]}, {centre_hi[0], centre_hi[1], centre_hi[2]}};
         r.objects = {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    }
+};
+
+// The SAH bins of a range on the three axes: per bin its triangles' count and extent on its axis,
+// and per axis a bit per non-empty bin, so that the cost sweeps visit those only.
+struct Bins {
+    std::uint32_t count[3][kSahBins] = {}, occupied[3] = {};
+    float lo[3][kSahBins], hi[3][kSahBins];
+
+    Bins() {
+        std::fill_n(&lo[0][0], 3 * kSahBins, kInf);
+        std::fill_n(&hi[0][0], 3 * kSahBins, -kInf);
+    }
+    // One pass bins all three axes, the centres' bins computed for the three at once.
+    void add(std::span<const Item> items, F4 origin, F4 scale) {
+        for (const Item& t : items) {
+            const I4 k = bins_of(centre_of(t), origin, scale);
+            for (int a = 0; a < 3; ++a) {
+                ++count[a][k[a]];
+                occupied[a] |= 1u << k[a];
+                hi[a][k[a]] = std::max(hi[a][k[a]], t.box.hi[a]);
+                lo[a][k[a]] = std::min(lo[a][k[a]], t.box.lo[a]);
+            }
+        }
+    }
+    // Adds the bins of the triangles after this one's: an extent keeps its value against an equal one,
+    // so the bins are those of one pass over both.
+    void append(const Bins& later) {
+        for (int a = 0; a < 3; ++a) {
+            occupied[a] |= later.occupied[a];
+            for (int k = 0; k < kSahBins; ++k) {
+                count[a][k] += later.count[a][k];
+                hi[a][k] = std::max(hi[a][k], later.hi[a][k]);
+                lo[a][k] = std::min(lo[a][k], later.lo[a][k]);
+            }
+        }
     }
 };
 
@@ -270,9 +313,7 @@ private:
         const double cell_measure = measure(r.box);
         double best_cost = kInf;
         int best_axis = -1, best_bin = 0;
-        // One pass bins all three axes, the centres' bins computed for the three at once; an axis with
-        // no extent, or too little to bin, is binned at scale 0 (all in bin 0) and skipped below. Per
-        // axis, `occupied` has a bit per non-empty bin, so that the sweeps visit those only.
+        // An axis with no extent, or too little to bin, is binned at scale 0 (all in bin 0) and skipped.
         bool binned[3];
         F4 origin{}, scale{};
         for (int a = 0; a < 3; ++a) {
@@ -282,21 +323,7 @@ private:
             binned[a] = extent > 0.f && std::isfinite(scale[a]);
             if (!binned[a]) scale[a] = 0.f;
         }
-        std::uint32_t count[3][kSahBins] = {}, occupied[3] = {};
-        float bin_lo[3][kSahBins], bin_hi[3][kSahBins];  // the extent of each bin's triangles on its axis
-        std::fill_n(&bin_lo[0][0], 3 * kSahBins, kInf);
-        std::fill_n(&bin_hi[0][0], 3 * kSahBins, -kInf);
-        for (std::uint32_t i = r.begin; i < r.end; ++i) {
-            const Item& t = items_[i];
-            const I4 bins = bins_of(centre_of(t), origin, scale);
-            for (int a = 0; a < 3; ++a) {
-                const int k = bins[a];
-                ++count[a][k];
-                occupied[a] |= 1u << k;
-                bin_hi[a][k] = std::max(bin_hi[a][k], t.box.hi[a]);
-                bin_lo[a][k] = std::min(bin_lo[a][k], t.box.lo[a]);
-            }
-        }
+        const Bins bins = bin(r, origin, scale);
         for (int a = 0; a < 3; ++a) {
             if (!binned[a]) continue;
             // Sweep the non-empty bins from the right for the right sides' counts and extents, then
@@ -306,23 +333,23 @@ private:
             double right_cost[kSahBins];
             std::uint32_t n = 0;
             float right_lo = kInf;
-            for (std::uint32_t rest = occupied[a] & ~1u; rest != 0;) {
+            for (std::uint32_t rest = bins.occupied[a] & ~1u; rest != 0;) {
                 const int k = std::bit_width(rest) - 1;
                 rest &= ~(1u << k);
-                n += count[a][k];
-                right_lo = std::min(right_lo, bin_lo[a][k]);
+                n += bins.count[a][k];
+                right_lo = std::min(right_lo, bins.lo[a][k]);
                 Box3 cell = r.box;
                 cell.lo[a] = std::max(cell.lo[a], right_lo);
                 right_cost[k] = n * measure(cell);
             }
             n = 0;
             float left_hi = -kInf;
-            for (std::uint32_t rest = occupied[a];;) {
+            for (std::uint32_t rest = bins.occupied[a];;) {
                 const int k = std::countr_zero(rest);
                 rest &= rest - 1;
                 if (rest == 0) break;  // the last non-empty bin: every triangle would be left
-                n += count[a][k];
-                left_hi = std::max(left_hi, bin_hi[a][k]);
+                n += bins.count[a][k];
+                left_hi = std::max(left_hi, bins.hi[a][k]);
                 Box3 cell = r.box;
                 cell.hi[a] = std::min(cell.hi[a], left_hi);
                 const double cost = p_.traversal_cost + p_.intersection_cost * (n * measure(cell) + right_cost[std::countr_zero(rest)]) / cell_measure;
@@ -335,6 +362,23 @@ private:
         if (best_axis < 0 || (leaf_is_cheaper && r.size() <= static_cast<std::uint32_t>(p_.sah_max_leaf)))
             return Decision{};
         return split_at(r, best_axis, [&](const Item& t) { return bins_of(centre_of(t), origin, scale)[best_axis] <= best_bin; });
+    }
+
+    // The range's bins. In parallel builds a range of parallel_pass_min triangles or more is binned by
+    // several threads, in blocks of kBlock combined in block order: the bins of one pass.
+    Bins bin(const Range& r, F4 origin, F4 scale) const {
+        const std::span<const Item> items(items_.data() + r.begin, r.size());
+        Bins bins;
+        if (p_.threads == 1 || r.size() < p_.parallel_pass_min) {
+            bins.add(items, origin, scale);
+            return bins;
+        }
+        std::vector<Bins> blocks((items.size() + kBlock - 1) / kBlock);
+        tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+            blocks[b].add(items.subspan(b * kBlock, std::min(kBlock, items.size() - b * kBlock)), origin, scale);
+        });
+        for (const Bins& block : blocks) bins.append(block);
+        return bins;
     }
 
     // An empty-space node: every triangle in one child, bounded by `left_clip`/`right_clip`; the
