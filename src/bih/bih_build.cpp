@@ -52,11 +52,36 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kSahBins = 32;
 static_assert(kSahBins <= 32, "a bin per bit of the occupied bins' mask");
 
-double area(const Box3& b) {
-    if (b.is_empty()) return 0.0;
-    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-    return 2.0 * (x * y + y * z + z * x);
-}
+// The SAH's measure of a node's cell cut on one axis, as a BIH cuts its children's: the surface area,
+// or for a flat cell (all triangles on a line, no area) the length. The other axes' extents are
+// computed once per node, in the arithmetic of a whole box's, so the same bits.
+class CellMeasure {
+public:
+    explicit CellMeasure(const Box3& cell) : empty_(cell.is_empty()) {
+        for (int a = 0; a < 3; ++a) {
+            length_[a] = cell.hi[a] - cell.lo[a];
+            extent_[a] = double(cell.hi[a]) - cell.lo[a];
+        }
+        flat_ = !(operator()(0, cell.lo.x, cell.hi.x) > 0.0);
+    }
+    // The measure of the cell with [lo, hi] on axis `a`.
+    double operator()(int a, float lo, float hi) const {
+        if (flat_) {
+            float length[3] = {length_[0], length_[1], length_[2]};
+            length[a] = hi - lo;
+            return double(length[0]) + length[1] + length[2];
+        }
+        if (empty_ || lo > hi) return 0.0;
+        double e[3] = {extent_[0], extent_[1], extent_[2]};
+        e[a] = double(hi) - lo;
+        return 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+    }
+
+private:
+    bool empty_, flat_ = false;
+    float length_[3];
+    double extent_[3];
+};
 
 int longest_axis(const Box3& b) {
     const Vec3 e = b.extent();
@@ -307,11 +332,9 @@ private:
             return cut_high ? cut(r, cut_axis, objects.hi[cut_axis], kInf, true)
                             : cut(r, cut_axis, -kInf, objects.lo[cut_axis], false);
 
-        // A flat cell (all triangles on a line) has no area: its length serves instead.
-        const bool flat = !(area(r.box) > 0.0);
-        auto measure = [flat](const Box3& b) { return flat ? double(b.hi.x - b.lo.x) + (b.hi.y - b.lo.y) + (b.hi.z - b.lo.z) : area(b); };
-        const double cell_measure = measure(r.box);
-        double best_cost = kInf;
+        const CellMeasure measure(r.box);
+        const double cell_measure = measure(0, r.box.lo.x, r.box.hi.x);
+        double best_cost = kInf, best_weight = kInf;
         int best_axis = -1, best_bin = 0;
         // An axis with no extent, or too little to bin, is binned at scale 0 (all in bin 0) and skipped.
         bool binned[3];
@@ -338,9 +361,7 @@ private:
                 rest &= ~(1u << k);
                 n += bins.count[a][k];
                 right_lo = std::min(right_lo, bins.lo[a][k]);
-                Box3 cell = r.box;
-                cell.lo[a] = std::max(cell.lo[a], right_lo);
-                right_cost[k] = n * measure(cell);
+                right_cost[k] = n * measure(a, std::max(r.box.lo[a], right_lo), r.box.hi[a]);
             }
             n = 0;
             float left_hi = -kInf;
@@ -350,10 +371,12 @@ private:
                 if (rest == 0) break;  // the last non-empty bin: every triangle would be left
                 n += bins.count[a][k];
                 left_hi = std::max(left_hi, bins.hi[a][k]);
-                Box3 cell = r.box;
-                cell.hi[a] = std::min(cell.hi[a], left_hi);
-                const double cost = p_.traversal_cost + p_.intersection_cost * (n * measure(cell) + right_cost[std::countr_zero(rest)]) / cell_measure;
-                if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
+                // The cost rises with the children's weight (positive factors, monotone rounding): one
+                // no lighter than the best's cannot cost less, and is not costed.
+                const double weight = n * measure(a, r.box.lo[a], std::min(r.box.hi[a], left_hi)) + right_cost[std::countr_zero(rest)];
+                if (!(weight < best_weight)) continue;
+                const double cost = p_.traversal_cost + p_.intersection_cost * weight / cell_measure;
+                if (cost < best_cost) best_cost = cost, best_weight = weight, best_axis = a, best_bin = k;
             }
         }
         // A leaf when no split beats testing every triangle, up to sah_max_leaf triangles; beyond, the
