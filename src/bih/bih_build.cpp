@@ -132,26 +132,34 @@ I4 bins_of(F4 centre, F4 origin, F4 scale) {
     return __builtin_convertvector(last < x ? last : x, I4);
 }
 
+// The order in which a pass meets the triangles of a range: by ascending or descending position.
+enum class Order { ascending, descending };
+
 // The bounds of the centres and boxes of one side of a partition. Box3::extend keeps its bound for an
-// equal value (std::min, std::max), which matters for +0 against -0 only: take_first is that rule, for
-// triangles met in ascending position; take_last lets an equal value replace the bound, for triangles
-// met in descending position, so that both keep the value of the lowest position.
+// equal value (std::min, std::max), which matters for +0 against -0 only: met in ascending position,
+// triangles are taken by that rule; met in descending position, an equal value replaces the bound, so
+// that both keep the value of the lowest position.
 struct Bounds {
     F4 centre_lo = F4{} + kInf, centre_hi = F4{} - kInf, lo = F4{} + kInf, hi = F4{} - kInf;
 
-    void take_first(const Item& t) {
+    template <Order order>
+    void take(const Item& t) {
         const F4 l = lo_of(t), h = hi_of(t), c = (l + h) * 0.5f;
-        lo = l < lo ? l : lo;
-        hi = hi < h ? h : hi;
-        centre_lo = c < centre_lo ? c : centre_lo;
-        centre_hi = centre_hi < c ? c : centre_hi;
+        lo = lower<order>(lo, l);
+        hi = higher<order>(hi, h);
+        centre_lo = lower<order>(centre_lo, c);
+        centre_hi = higher<order>(centre_hi, c);
     }
-    void take_last(const Item& t) {
-        const F4 l = lo_of(t), h = hi_of(t), c = (l + h) * 0.5f;
-        lo = lo < l ? lo : l;
-        hi = h < hi ? hi : h;
-        centre_lo = centre_lo < c ? centre_lo : c;
-        centre_hi = c < centre_hi ? centre_hi : c;
+    // The operand order makes each one instruction (minps, maxps) with the rule for equal values.
+    template <Order order>
+    static F4 lower(F4 bound, F4 v) {
+        if constexpr (order == Order::ascending) return v < bound ? v : bound;
+        else return bound < v ? bound : v;
+    }
+    template <Order order>
+    static F4 higher(F4 bound, F4 v) {
+        if constexpr (order == Order::ascending) return bound < v ? v : bound;
+        else return v < bound ? bound : v;
     }
     void store(Range& r) const {
         r.centres = {{centre_lo[0], centre_lo[1], centre_lo[2]}, {centre_hi[0], centre_hi[1], centre_hi[2]}};
@@ -284,17 +292,17 @@ private:
         Item* first = items_.data() + r.begin;
         Item* last = items_.data() + r.end;
         for (;;) {
-            for (; first != last && goes_left(*first); ++first) left.take_first(*first);
+            for (; first != last && goes_left(*first); ++first) left.take<Order::ascending>(*first);
             if (first == last) break;
             --last;
-            for (; first != last && !goes_left(*last); --last) right.take_last(*last);
+            for (; first != last && !goes_left(*last); --last) right.take<Order::descending>(*last);
             if (first == last) {  // *first, which goes right, stays where it is
-                right.take_last(*first);
+                right.take<Order::descending>(*first);
                 break;
             }
             std::iter_swap(first, last);
-            left.take_first(*first);
-            right.take_last(*last);
+            left.take<Order::ascending>(*first);
+            right.take<Order::descending>(*last);
             ++first;
         }
         const auto mid = static_cast<std::uint32_t>(first - items_.data());
