@@ -282,10 +282,11 @@ private:
 
     // Partitions the range in place into the triangles for which `goes_left` holds and the rest (both
     // sides non-empty), with the clip planes at the two sides' extents on `a`, and bounds each side in
-    // the same pass. The partition is Hoare's, step for step libstdc++'s std::partition (which main's
-    // builder called), so the order and the tree are unchanged. Left triangles are met in ascending
-    // final position and right ones in descending: the right side's bounds take equal values (+0 and
-    // -0) from the lower position, as a scan in ascending order does, so the planes' bits are the same.
+    // the same pass. The partition is Hoare's (Quicksort, 1962), step for step libstdc++'s
+    // std::partition (which main's builder called), so the order and the tree are unchanged. Left
+    // triangles are met in ascending final position and right ones in descending: the right side's
+    // bounds take equal values (+0 and -0) from the lower position, as a scan in ascending order does,
+    // so the planes' bits are the same.
     template <class GoesLeft>
     Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
         Bounds left, right;
