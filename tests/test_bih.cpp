@@ -82,19 +82,28 @@ TEST(Bih, LeavesPartitionTheTriangles) {
     EXPECT_TRUE(std::all_of(covered.begin(), covered.end(), [](int c) { return c == 1; }));
 }
 
+// Spheres of even density, and a city of uneven density whose SAH hierarchy cuts empty space.
 TEST(Bih, SameHierarchyBytesAtAnyThreadCount) {
-    const Scene& scene = test::cached_scene("builtin:spheres?tris=40000");
-    for (detail::BihSplit split : {detail::BihSplit::global, detail::BihSplit::sah}) {
-        detail::BihBuildParams p;
-        p.split = split;
-        p.threads = 1;
-        const detail::BihTree one = detail::build_bih(scene.triangles, p);
-        for (unsigned threads : {2u, 0u}) {
-            p.threads = threads;
-            const detail::BihTree many = detail::build_bih(scene.triangles, p);
-            ASSERT_EQ(one.nodes.size(), many.nodes.size()) << threads << " threads";
-            EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::BihNode)), 0);
-            EXPECT_EQ(one.prims, many.prims);
+    for (const std::string spec : {"builtin:spheres?tris=40000", "builtin:city?tris=20000"}) {
+        const Scene& scene = test::cached_scene(spec);
+        for (detail::BihSplit split : {detail::BihSplit::global, detail::BihSplit::sah}) {
+            detail::BihBuildParams p;
+            p.split = split;
+            p.threads = 1;
+            const detail::BihTree one = detail::build_bih(scene.triangles, p);
+            // Also with the SAH's parallel binning of large nodes brought down to this scene's top nodes.
+            for (const std::size_t pass_min : {p.parallel_pass_min, std::size_t{4096}})
+                for (unsigned threads : {2u, 3u, 4u, 0u}) {
+                    p.threads = threads;
+                    p.parallel_pass_min = pass_min;
+                    const detail::BihTree many = detail::build_bih(scene.triangles, p);
+                    const std::string what =
+                        spec + ", " + std::to_string(threads) + " threads, parallel binning from " + std::to_string(pass_min);
+                    ASSERT_EQ(one.nodes.size(), many.nodes.size()) << what;
+                    EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::BihNode)), 0)
+                        << what;
+                    EXPECT_EQ(one.prims, many.prims) << what;
+                }
         }
     }
 }

@@ -18,14 +18,22 @@
 //
 // Nothing is duplicated: the triangle array is reordered and leaves are ranges of it, so memory is
 // known in advance. The builder reorders records of box and triangle index in place, read in order
-// (no indirection): per node one pass bins all three axes, one partitions, and one bounds the two
-// children's centres and boxes, which their own decisions then need. Large ranges are built as
-// parallel tasks (kernel/subtree.hpp keeps the layout independent of the thread count).
+// (no indirection): per node one pass bins all three axes (the SAH's centre bins computed for the
+// three at once, in four-float vectors), and one partitions the range and bounds the two children's
+// centres and boxes, which their own decisions then need; the cost sweeps visit non-empty bins only.
+// Large ranges are built as parallel tasks (kernel/subtree.hpp keeps the layout independent of the
+// thread count), and the largest are also binned by several threads in blocks combined in order.
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
+#include <vector>
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -36,16 +44,44 @@ namespace cellrt::detail {
 namespace {
 
 constexpr std::size_t kParallelMin = 4096;
+// Ranges binned by several threads (BihBuildParams::parallel_pass_min) are cut in blocks of this many.
+constexpr std::size_t kBlock = 16384;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The SAH's bins per axis (its costs and largest leaf are parameters: BihBuildParams).
 constexpr int kSahBins = 32;
+static_assert(kSahBins <= 32, "a bin per bit of the occupied bins' mask");
 
-double area(const Box3& b) {
-    if (b.is_empty()) return 0.0;
-    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-    return 2.0 * (x * y + y * z + z * x);
-}
+// The SAH's measure of a node's cell cut on one axis, as a BIH cuts its children's: the surface area,
+// or for a flat cell (all triangles on a line, no area) the length. The other axes' extents are
+// computed once per node, in the arithmetic of a whole box's, so the same bits.
+class CellMeasure {
+public:
+    explicit CellMeasure(const Box3& cell) : empty_(cell.is_empty()) {
+        for (int a = 0; a < 3; ++a) {
+            length_[a] = cell.hi[a] - cell.lo[a];
+            extent_[a] = double(cell.hi[a]) - cell.lo[a];
+        }
+        flat_ = !(operator()(0, cell.lo.x, cell.hi.x) > 0.0);
+    }
+    // The measure of the cell with [lo, hi] on axis `a`.
+    double operator()(int a, float lo, float hi) const {
+        if (flat_) {
+            float length[3] = {length_[0], length_[1], length_[2]};
+            length[a] = hi - lo;
+            return double(length[0]) + length[1] + length[2];
+        }
+        if (empty_ || lo > hi) return 0.0;
+        double e[3] = {extent_[0], extent_[1], extent_[2]};
+        e[a] = double(hi) - lo;
+        return 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+    }
+
+private:
+    bool empty_, flat_ = false;
+    float length_[3];
+    double extent_[3];
+};
 
 int longest_axis(const Box3& b) {
     const Vec3 e = b.extent();
@@ -66,6 +102,105 @@ struct Item {
     Box3 box;
     std::uint32_t triangle;
     Vec3 centre() const { return box.center(); }
+};
+static_assert(sizeof(Item) == 28 && offsetof(Item, box.hi) == 12);
+
+// Four floats (x, y, z and a spare lane), GCC's and Clang's generic vectors: SSE on x86-64, what the
+// target has elsewhere. Per triangle, the builder's passes do the three axes' arithmetic at once.
+typedef float F4 __attribute__((vector_size(16)));
+typedef std::int32_t I4 __attribute__((vector_size(16)));
+
+// The item's box corners, read as one unaligned load each; the lane past z is the next field (hi.x
+// for `lo`, the index for `hi`, zeroed: its bits could be a denormal, which is slow to add).
+F4 lo_of(const Item& t) {
+    F4 v;
+    std::memcpy(&v, &t, sizeof v);
+    return v;
+}
+F4 hi_of(const Item& t) {
+    F4 v;
+    std::memcpy(&v, reinterpret_cast<const char*>(&t) + offsetof(Item, box.hi), sizeof v);
+    return std::bit_cast<F4>(std::bit_cast<I4>(v) & I4{-1, -1, -1, 0});
+}
+// Box3::center's arithmetic, so the same bits.
+F4 centre_of(const Item& t) { return (lo_of(t) + hi_of(t)) * 0.5f; }
+
+// The SAH bin of a centre on each axis: (c - origin) * scale, at most kSahBins - 1, truncated. The
+// origin is the least centre of the node, so the product is never negative.
+I4 bins_of(F4 centre, F4 origin, F4 scale) {
+    const F4 x = (centre - origin) * scale, last = F4{} + float(kSahBins - 1);
+    return __builtin_convertvector(last < x ? last : x, I4);
+}
+
+// The order in which a pass meets the triangles of a range: by ascending or descending position.
+enum class Order { ascending, descending };
+
+// The bounds of the centres and boxes of one side of a partition. Box3::extend keeps its bound for an
+// equal value (std::min, std::max), which matters for +0 against -0 only: met in ascending position,
+// triangles are taken by that rule; met in descending position, an equal value replaces the bound, so
+// that both keep the value of the lowest position.
+struct Bounds {
+    F4 centre_lo = F4{} + kInf, centre_hi = F4{} - kInf, lo = F4{} + kInf, hi = F4{} - kInf;
+
+    template <Order order>
+    void take(const Item& t) {
+        const F4 l = lo_of(t), h = hi_of(t), c = (l + h) * 0.5f;
+        lo = lower<order>(lo, l);
+        hi = higher<order>(hi, h);
+        centre_lo = lower<order>(centre_lo, c);
+        centre_hi = higher<order>(centre_hi, c);
+    }
+    // The operand order makes each one instruction (minps, maxps) with the rule for equal values.
+    template <Order order>
+    static F4 lower(F4 bound, F4 v) {
+        if constexpr (order == Order::ascending) return v < bound ? v : bound;
+        else return bound < v ? bound : v;
+    }
+    template <Order order>
+    static F4 higher(F4 bound, F4 v) {
+        if constexpr (order == Order::ascending) return bound < v ? v : bound;
+        else return v < bound ? bound : v;
+    }
+    void store(Range& r) const {
+        r.centres = {{centre_lo[0], centre_lo[1], centre_lo[2]}, {centre_hi[0], centre_hi[1], centre_hi[2]}};
+        r.objects = {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    }
+};
+
+// The SAH bins of a range on the three axes: per bin its triangles' count and extent on its axis,
+// and per axis a bit per non-empty bin, so that the cost sweeps visit those only.
+struct Bins {
+    std::uint32_t count[3][kSahBins] = {}, occupied[3] = {};
+    float lo[3][kSahBins], hi[3][kSahBins];
+
+    Bins() {
+        std::fill_n(&lo[0][0], 3 * kSahBins, kInf);
+        std::fill_n(&hi[0][0], 3 * kSahBins, -kInf);
+    }
+    // One pass bins all three axes, the centres' bins computed for the three at once.
+    void add(std::span<const Item> items, F4 origin, F4 scale) {
+        for (const Item& t : items) {
+            const I4 k = bins_of(centre_of(t), origin, scale);
+            for (int a = 0; a < 3; ++a) {
+                ++count[a][k[a]];
+                occupied[a] |= 1u << k[a];
+                hi[a][k[a]] = std::max(hi[a][k[a]], t.box.hi[a]);
+                lo[a][k[a]] = std::min(lo[a][k[a]], t.box.lo[a]);
+            }
+        }
+    }
+    // Adds the bins of the triangles after this one's: an extent keeps its value against an equal one,
+    // so the bins are those of one pass over both.
+    void append(const Bins& later) {
+        for (int a = 0; a < 3; ++a) {
+            occupied[a] |= later.occupied[a];
+            for (int k = 0; k < kSahBins; ++k) {
+                count[a][k] += later.count[a][k];
+                hi[a][k] = std::max(hi[a][k], later.hi[a][k]);
+                lo[a][k] = std::min(lo[a][k], later.lo[a][k]);
+            }
+        }
+    }
 };
 
 class BihBuilder {
@@ -146,26 +281,40 @@ private:
     }
 
     // Partitions the range in place into the triangles for which `goes_left` holds and the rest (both
-    // sides non-empty), with the clip planes at the two sides' extents on `a`, and bounds each side.
+    // sides non-empty), with the clip planes at the two sides' extents on `a`, and bounds each side in
+    // the same pass. The partition is Hoare's (Quicksort, 1962), step for step libstdc++'s
+    // std::partition (which main's builder called), so the order and the tree are unchanged. Left
+    // triangles are met in ascending final position and right ones in descending: the right side's
+    // bounds take equal values (+0 and -0) from the lower position, as a scan in ascending order does,
+    // so the planes' bits are the same.
     template <class GoesLeft>
     Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
-        const auto mid_it = std::partition(items_.begin() + r.begin, items_.begin() + r.end, goes_left);
-        const auto mid = static_cast<std::uint32_t>(mid_it - items_.begin());
+        Bounds left, right;
+        Item* first = items_.data() + r.begin;
+        Item* last = items_.data() + r.end;
+        for (;;) {
+            for (; first != last && goes_left(*first); ++first) left.take<Order::ascending>(*first);
+            if (first == last) break;
+            --last;
+            for (; first != last && !goes_left(*last); --last) right.take<Order::descending>(*last);
+            if (first == last) {  // *first, which goes right, stays where it is
+                right.take<Order::descending>(*first);
+                break;
+            }
+            std::iter_swap(first, last);
+            left.take<Order::ascending>(*first);
+            right.take<Order::descending>(*last);
+            ++first;
+        }
+        const auto mid = static_cast<std::uint32_t>(first - items_.data());
         Decision d;
         d.kind = Kind::split;
         d.axis = a;
         d.left = d.right = r;
         d.left.end = mid;
         d.right.begin = mid;
-        for (Range* side : {&d.left, &d.right}) {
-            Box3 centres, objects;
-            for (std::uint32_t i = side->begin; i < side->end; ++i) {
-                objects.extend(items_[i].box);
-                centres.extend(items_[i].centre());
-            }
-            side->centres = centres;
-            side->objects = objects;
-        }
+        left.store(d.left);
+        right.store(d.right);
         d.left_clip = d.left.objects.hi[a];
         d.right_clip = d.right.objects.lo[a];
         d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
@@ -192,68 +341,51 @@ private:
             return cut_high ? cut(r, cut_axis, objects.hi[cut_axis], kInf, true)
                             : cut(r, cut_axis, -kInf, objects.lo[cut_axis], false);
 
-        struct Bin {
-            std::uint32_t count = 0;
-            float hi = -kInf, lo = kInf;  // the extent of the bin's triangles on the axis
-        };
-        // A flat cell (all triangles on a line) has no area: its length serves instead.
-        const bool flat = !(area(r.box) > 0.0);
-        auto measure = [flat](const Box3& b) { return flat ? double(b.hi.x - b.lo.x) + (b.hi.y - b.lo.y) + (b.hi.z - b.lo.z) : area(b); };
-        const double cell_measure = measure(r.box);
-        double best_cost = kInf;
+        const CellMeasure measure(r.box);
+        const double cell_measure = measure(0, r.box.lo.x, r.box.hi.x);
+        double best_cost = kInf, best_weight = kInf;
         int best_axis = -1, best_bin = 0;
-        // One pass bins all three axes; an axis with no extent, or too little to bin, is binned at
-        // scale 0 (all in bin 0) and skipped below.
+        // An axis with no extent, or too little to bin, is binned at scale 0 (all in bin 0) and skipped.
         bool binned[3];
-        float scales[3];
+        F4 origin{}, scale{};
         for (int a = 0; a < 3; ++a) {
             const float extent = centres.hi[a] - centres.lo[a];
-            scales[a] = kSahBins / extent;
-            binned[a] = extent > 0.f && std::isfinite(scales[a]);
-            if (!binned[a]) scales[a] = 0.f;
+            origin[a] = centres.lo[a];
+            scale[a] = kSahBins / extent;
+            binned[a] = extent > 0.f && std::isfinite(scale[a]);
+            if (!binned[a]) scale[a] = 0.f;
         }
-        Bin all_bins[3][kSahBins];
-        for (std::uint32_t i = r.begin; i < r.end; ++i) {
-            const Item& t = items_[i];
-            const Vec3 c = t.centre();
-            for (int a = 0; a < 3; ++a) {
-                Bin& b = all_bins[a][bin_of(c[a], centres.lo[a], scales[a])];
-                ++b.count;
-                b.hi = std::max(b.hi, t.box.hi[a]);
-                b.lo = std::min(b.lo, t.box.lo[a]);
-            }
-        }
+        const Bins bins = bin(r, origin, scale);
         for (int a = 0; a < 3; ++a) {
             if (!binned[a]) continue;
-            const Bin* bins = all_bins[a];
-            // Sweep from the right for the right sides' counts and extents, then from the left. An empty
-            // bin changes neither: its costs are its neighbour's, copied, and as a split it ties with the
-            // bin before it, which wins (small nodes have mostly empty bins).
+            // Sweep the non-empty bins from the right for the right sides' counts and extents, then
+            // from the left. An empty bin changes neither: as a split it ties with the non-empty bin
+            // before it, which wins, and the right side beyond a bin is that beyond the next non-empty
+            // one (small nodes, the most numerous, have mostly empty bins).
             double right_cost[kSahBins];
-            std::uint32_t count = 0;
+            std::uint32_t n = 0;
             float right_lo = kInf;
-            for (int k = kSahBins - 1; k > 0; --k) {
-                if (bins[k].count == 0 && k < kSahBins - 1) {
-                    right_cost[k] = right_cost[k + 1];
-                    continue;
-                }
-                count += bins[k].count;
-                right_lo = std::min(right_lo, bins[k].lo);
-                Box3 cell = r.box;
-                cell.lo[a] = std::max(cell.lo[a], right_lo);
-                right_cost[k] = count * measure(cell);
+            for (std::uint32_t rest = bins.occupied[a] & ~1u; rest != 0;) {
+                const int k = std::bit_width(rest) - 1;
+                rest &= ~(1u << k);
+                n += bins.count[a][k];
+                right_lo = std::min(right_lo, bins.lo[a][k]);
+                right_cost[k] = n * measure(a, std::max(r.box.lo[a], right_lo), r.box.hi[a]);
             }
-            count = 0;
+            n = 0;
             float left_hi = -kInf;
-            for (int k = 0; k < kSahBins - 1; ++k) {
-                if (bins[k].count == 0) continue;
-                count += bins[k].count;
-                left_hi = std::max(left_hi, bins[k].hi);
-                if (count == r.size()) continue;
-                Box3 cell = r.box;
-                cell.hi[a] = std::min(cell.hi[a], left_hi);
-                const double cost = p_.traversal_cost + p_.intersection_cost * (count * measure(cell) + right_cost[k + 1]) / cell_measure;
-                if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
+            for (std::uint32_t rest = bins.occupied[a];;) {
+                const int k = std::countr_zero(rest);
+                rest &= rest - 1;
+                if (rest == 0) break;  // the last non-empty bin: every triangle would be left
+                n += bins.count[a][k];
+                left_hi = std::max(left_hi, bins.hi[a][k]);
+                // The cost rises with the children's weight (positive factors, monotone rounding): one
+                // no lighter than the best's cannot cost less, and is not costed.
+                const double weight = n * measure(a, r.box.lo[a], std::min(r.box.hi[a], left_hi)) + right_cost[std::countr_zero(rest)];
+                if (!(weight < best_weight)) continue;
+                const double cost = p_.traversal_cost + p_.intersection_cost * weight / cell_measure;
+                if (cost < best_cost) best_cost = cost, best_weight = weight, best_axis = a, best_bin = k;
             }
         }
         // A leaf when no split beats testing every triangle, up to sah_max_leaf triangles; beyond, the
@@ -261,12 +393,24 @@ private:
         const bool leaf_is_cheaper = !(best_cost < p_.intersection_cost * r.size());
         if (best_axis < 0 || (leaf_is_cheaper && r.size() <= static_cast<std::uint32_t>(p_.sah_max_leaf)))
             return Decision{};
-        const float lo = centres.lo[best_axis], scale = kSahBins / (centres.hi[best_axis] - lo);
-        return split_at(r, best_axis, [&](const Item& t) { return bin_of(t.centre()[best_axis], lo, scale) <= best_bin; });
+        return split_at(r, best_axis, [&](const Item& t) { return bins_of(centre_of(t), origin, scale)[best_axis] <= best_bin; });
     }
 
-    static int bin_of(float centre, float lo, float scale) {
-        return static_cast<int>(std::clamp((centre - lo) * scale, 0.f, static_cast<float>(kSahBins - 1)));
+    // The range's bins. In parallel builds a range of parallel_pass_min triangles or more is binned by
+    // several threads, in blocks of kBlock combined in block order: the bins of one pass.
+    Bins bin(const Range& r, F4 origin, F4 scale) const {
+        const std::span<const Item> items(items_.data() + r.begin, r.size());
+        Bins bins;
+        if (p_.threads == 1 || r.size() < p_.parallel_pass_min) {
+            bins.add(items, origin, scale);
+            return bins;
+        }
+        std::vector<Bins> blocks((items.size() + kBlock - 1) / kBlock);
+        tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+            blocks[b].add(items.subspan(b * kBlock, std::min(kBlock, items.size() - b * kBlock)), origin, scale);
+        });
+        for (const Bins& block : blocks) bins.append(block);
+        return bins;
     }
 
     // An empty-space node: every triangle in one child, bounded by `left_clip`/`right_clip`; the

@@ -3,6 +3,7 @@
 // bih_build.cpp, traversals in bih_traversal.hpp.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -40,6 +41,9 @@ struct BihBuildParams {
     double intersection_cost = 20.0;
     int sah_max_leaf = 16;
     unsigned threads = 0;  // 0: all hardware threads; the hierarchy is the same for every value
+    // split=sah, parallel builds: nodes with at least this many triangles are binned by several
+    // threads (not a `-P` parameter: a test lowers it to check that the hierarchy stays the same).
+    std::size_t parallel_pass_min = 65536;
 };
 
 struct BihTree {
