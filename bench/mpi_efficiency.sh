@@ -31,19 +31,26 @@ done
 python3 - "$work" "$size" "${names[@]}" <<'PY'
 import json, statistics, sys, glob, os
 work, size, names = sys.argv[1], sys.argv[2], sys.argv[3:]
-cpu = {}
+cpu, wall = {}, {}
 for line in open(os.path.join(work, "time.txt")):
     n, s, u, k, e = line.split()
     cpu.setdefault((n, s), []).append(float(u) + float(k))
+    wall.setdefault((n, s), []).append(float(e))
 med = statistics.median
-print(f"{'configuration':16} {'render s':>9} {'min':>6} {'max':>6} {'ratio':>6} {'frame CPU s':>12} {'ratio':>6}")
+# render s: the program's own frame time (cellrt: the tracing; cellrt-mpi: render_tiles, which also
+# holds the frame's allocation and each rank's FrameRenderer). frame wall s: the whole command's
+# elapsed time less the 16 x 16 run's, alike for both programs (at /usr/bin/time's 10 ms resolution).
+print(f"{'configuration':16} {'render s':>9} {'min':>6} {'max':>6} {'ratio':>6} {'frame wall s':>13} {'ratio':>6} "
+      f"{'frame CPU s':>12} {'ratio':>6}")
 base = None
 for n in names:
     runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(work, f"{n}.{size}.*.json")))]
     t = [j["render_seconds"] for j in runs]
+    frame_wall = med(wall[(n, size)]) - med(wall[(n, "16x16")])
     frame_cpu = med(cpu[(n, size)]) - med(cpu[(n, "16x16")])
-    base = base or (med(t), frame_cpu)
-    print(f"{n:16} {med(t):9.3f} {min(t):6.3f} {max(t):6.3f} {med(t) / base[0]:6.3f} {frame_cpu:12.3f} {frame_cpu / base[1]:6.3f}")
+    base = base or (med(t), frame_wall, frame_cpu)
+    print(f"{n:16} {med(t):9.3f} {min(t):6.3f} {max(t):6.3f} {med(t) / base[0]:6.3f} {frame_wall:13.3f} "
+          f"{frame_wall / base[1]:6.3f} {frame_cpu:12.3f} {frame_cpu / base[2]:6.3f}")
     if "ranks" in runs[-1]:
         for k in runs[-1]["ranks"]:
             print(f"    rank {k['rank']}: {k['threads']} threads, {k['tiles']} tiles, busy {k['busy_seconds']:.3f} s of "
