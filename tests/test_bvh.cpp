@@ -208,6 +208,11 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
 TEST(Routed, PickerTakesThePathThatTookLessTime) {
     using detail::RoutePicker;
     RoutePicker picker;
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) {  // coherence alone, nothing traced twice
+        const RoutePicker::Choice c = picker.pick(static_cast<int>(i % 2));
+        EXPECT_EQ(c.path, static_cast<int>(i % 2));
+        EXPECT_FALSE(c.sampled);
+    }
     const RoutePicker::Choice warm = picker.pick(1);
     EXPECT_EQ(warm.path, 1);
     EXPECT_TRUE(warm.sampled);
@@ -234,6 +239,7 @@ TEST(Routed, PickerSamplesFewBatchesOnceItKnows) {
         return s;
     };
     RoutePicker learning;
+    EXPECT_EQ(sampled(learning, RoutePicker::kPrior), 0);
     EXPECT_NEAR(sampled(learning, 8000), 8000 / RoutePicker::kLearn, 8000 / RoutePicker::kLearn / 4);
     RoutePicker close, clear;
     for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {

@@ -21,20 +21,24 @@ const ParamTable& routed_params();
 const std::vector<std::string>& routed_traversals();
 
 // Which of the two paths traces the next batch of one kind (closest or any hit, coherent or not): the
-// one that has taken less time on the batches of that kind that both have traced. Both paths are exact,
-// so a batch can be traced by both, with the same answers: a sampled batch is, and the two times are a
-// paired sample, free of the spread between batches (a tile of background against one of the object
-// is a factor of ten, more than the two paths differ). The first batch is traced by both to warm
-// their caches, not counted; then one batch in kLearn is sampled until kLearned samples are in, one in
-// kSample after that (one in kSampleFar while one path has taken more than kFar times the other's
-// time, so that a clear choice costs little), picked by a hash of the batch's number rather than
-// every n-th (which would sample the same column of tiles of a frame). A sample's dearer time counts at most kClamp times the
-// cheaper one, so that a batch whose thread the system preempted (milliseconds, on a batch of tens of
-// microseconds) cannot outweigh the others. Before any sample, coherence's choice (the prior) goes. Counts are atomics: any number of threads route and record at once, and a race only blurs a
-// figure. The choice changes only the time, never an answer.
+// one that has taken less time on the batches of that kind that both have traced. Both paths are
+// exact, so a batch can be traced by both, with the same answers: a sampled batch is, and the two
+// times are a paired sample, free of the spread between batches (a tile of background against one of
+// the object is a factor of ten, more than the two paths differ).
+//
+// The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
+// Python caller's one query, pays nothing for the choice; the next is traced by both to warm their
+// caches, not counted; then one batch in kLearn is sampled until kLearned samples are in, one in
+// kSample after that, and one in kSampleFar while one path has taken more than kFar times the
+// other's time (a clear choice costs little). Sampled batches are picked by a hash of the batch's
+// number, not every n-th, which would sample the same column of a frame's tiles. A sample's dearer
+// time counts at most kClamp times the cheaper one, so that a batch whose thread the system preempted
+// (milliseconds, on a batch of tens of microseconds) cannot outweigh the others. Counts are atomics:
+// any number of threads route and record at once, and a race only blurs a figure. The choice changes
+// only the time, never an answer.
 class RoutePicker {
 public:
-    static constexpr std::uint64_t kLearn = 8, kLearned = 16, kSample = 64, kSampleFar = 512;
+    static constexpr std::uint64_t kPrior = 8, kLearn = 8, kLearned = 16, kSample = 64, kSampleFar = 512;
     static constexpr double kClamp = 8.0, kFar = 1.5;
 
     struct Choice {
@@ -45,9 +49,10 @@ public:
 
     Choice pick(int prior) {
         const std::uint64_t n = batches_.fetch_add(1, std::memory_order_relaxed);
+        if (n < kPrior) return {prior, false, false};
         const double t0 = seconds_[0].load(std::memory_order_relaxed), t1 = seconds_[1].load(std::memory_order_relaxed);
         const int fast = t0 == t1 ? prior : (t0 < t1 ? 0 : 1);
-        if (n == 0) return {fast, true, false};
+        if (n == kPrior) return {fast, true, false};
         const bool far = fast == 0 ? t1 > kFar * t0 : t0 > kFar * t1;
         const std::uint64_t period =
             samples_.load(std::memory_order_relaxed) < kLearned ? kLearn : (far ? kSampleFar : kSample);
