@@ -156,7 +156,7 @@ inline unsigned leaf_lanes(const BvhNode& node) {
 inline constexpr int kBvhStackSize = 7 * 96 + 1;
 inline constexpr int kBvhStackSlack = kBvhWidth;
 
-#if defined(CELLRT_SIMD_AVX2) && !defined(CELLRT_SIMD_AVX512)
+#if defined(CELLRT_SIMD_AVX2)
 // For each 8-bit mask, the indices of its set bits in ascending order, a byte each: the lane
 // permutation that packs the chosen lanes to the front. AVX2 has no compressing store (AVX-512's
 // vpcompressd); a permutation from this table does the same without a loop over the bits, whose
@@ -175,15 +175,18 @@ inline constexpr PackTable kPackTable{};
 // Pushes the children of `met`: their words and, where `entry_stack` is given, their entry distances.
 inline void push_children(const BvhNode& node, unsigned met, F entries, std::uint32_t* word_stack, float* entry_stack,
                           int& size) {
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2)
+    const auto words = reinterpret_cast<__m256i>(load_u(node.child));
+    const auto lanes = reinterpret_cast<__m256>(entries);
+#endif
 #if defined(CELLRT_SIMD_AVX512)
     const auto mask = static_cast<__mmask8>(met);
-    _mm256_mask_compressstoreu_epi32(word_stack + size, mask, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child)));
-    if (entry_stack) _mm256_mask_compressstoreu_ps(entry_stack + size, mask, reinterpret_cast<__m256>(entries));
+    _mm256_mask_compressstoreu_epi32(word_stack + size, mask, words);
+    if (entry_stack) _mm256_mask_compressstoreu_ps(entry_stack + size, mask, lanes);
 #elif defined(CELLRT_SIMD_AVX2)
     const __m256i order = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kPackTable.order[met])));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(word_stack + size),
-                        _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child)), order));
-    if (entry_stack) _mm256_storeu_ps(entry_stack + size, _mm256_permutevar8x32_ps(reinterpret_cast<__m256>(entries), order));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(word_stack + size), _mm256_permutevar8x32_epi32(words, order));
+    if (entry_stack) _mm256_storeu_ps(entry_stack + size, _mm256_permutevar8x32_ps(lanes, order));
 #else
     for (unsigned m = met, n = size; m; m &= m - 1, ++n) {
         word_stack[n] = node.child[__builtin_ctz(m)];
