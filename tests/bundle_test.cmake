@@ -1,6 +1,6 @@
 # tools/bundle.sh end to end: the bundle holds the programs and the libraries they need beyond the C
 # and C++ runtimes, its `run` starts a program with them, and an existing folder is never replaced.
-# Arguments: SOURCE, BUILD and WORK.
+# Arguments: SOURCE, BUILD, WORK, and WITH_MPI (whether this build makes the MPI programs).
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(ENV{CELLRT_BUILD} ${BUILD})
@@ -10,7 +10,7 @@ if(NOT rc EQUAL 0)
 endif()
 # With the MPI programs where they were built, and mpirun with them.
 set(programs cellrt cellrt_scaling cellrt_bench)
-if(EXISTS ${BUILD}/cellrt-mpi)
+if(WITH_MPI)
   list(APPEND programs cellrt-mpi cellrt_bench-mpi cellrt_scaling-mpi mpirun orted)
 endif()
 foreach(program ${programs})
@@ -53,7 +53,7 @@ endforeach()
 # machine allows a private mount namespace (root), the installed Open MPI's components, help texts,
 # settings and PMIx are covered by an empty folder there, so that only the bundle's can be found.
 # Sanitized builds have no MPI programs (CMakeLists.txt), so this runs in the Release stage.
-if(EXISTS ${BUILD}/cellrt-mpi)
+if(WITH_MPI)
   set(frame builtin:city?tris=300 --size 32x24 -o)
   execute_process(COMMAND ${WORK}/bundle/run cellrt render ${frame} ${WORK}/plain.pfm RESULT_VARIABLE rc)
   file(WRITE ${WORK}/hidden.sh [=[
