@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -130,6 +131,24 @@ TEST_F(Distributed, CacheStudySplitOverRanksWritesTheOneProcessResults) {
         EXPECT_EQ(without_wall(read(out / "cache_study.csv")), csv) << ranks << " ranks";
         EXPECT_EQ(read(out / "best_layouts.md"), read(dir.path / "plain" / "best_layouts.md")) << ranks << " ranks";
     }
+}
+
+// The ranks of a sweep wait at the end of their share for the longest share, whole runs long, so its
+// time-out defaults to a day; a frame's ranks wait for one tile, 120 s. (A cache study whose shares
+// ended more than 120 s apart was ended as if a rank had stopped answering.)
+TEST_F(Distributed, ASweepWaitsForWholeRunsAFrameForOneTile) {
+    auto default_timeout = [&](const std::string& command) {
+        std::string help;
+        FILE* p = ::popen((mpirun(1) + mpi + " " + command + " --help 2>&1").c_str(), "r");
+        char buffer[4096];
+        for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, p)) > 0;) help.append(buffer, n);
+        EXPECT_EQ(::pclose(p), 0) << help;
+        const auto at = help.find("--rank-timeout");
+        // The option's entry: its line and its description's (CLI11 wraps it), up to the next option.
+        return at == std::string::npos ? help : help.substr(at, help.find("\n  -", at) - at);
+    };
+    EXPECT_NE(default_timeout("cache-study").find("(default 86400)"), std::string::npos);
+    EXPECT_NE(default_timeout("render").find("(default 120)"), std::string::npos);
 }
 
 // A failure of `program`: a non-zero status, one error line naming `rank` and holding `cause`, no

@@ -27,9 +27,9 @@ Options g_options;
 
 distributed::Session& session() { return *g_session; }
 
-// The longest time-out, a day, and a benchmark's default: a benchmark rank waits for the others' runs at
-// the end of its sweep as long as the longest share of runs lasts (a full sweep of the shared scenes
-// runs for hours on one machine).
+// The longest time-out, a day, and the default of the sweeps (cache-study, the benchmarks): a rank
+// waits for the others' runs at the end of its share as long as the longest share lasts (a full sweep
+// of the shared scenes runs for hours on one machine), where a frame's ranks wait for one tile.
 constexpr std::chrono::seconds kLongestRankTimeout{86400};
 
 void add_timeout_option(CLI::App& cmd, std::chrono::seconds fallback) {
@@ -42,11 +42,11 @@ void add_timeout_option(CLI::App& cmd, std::chrono::seconds fallback) {
         ->check(CLI::Range(0.1, static_cast<double>(kLongestRankTimeout.count())));
 }
 
-void add_common_options(CLI::App& cmd) {
+void add_common_options(CLI::App& cmd, std::chrono::seconds timeout) {
     cmd.add_flag("--broadcast-scene", g_options.broadcast_scene,
                  "Rank 0 loads the scene and sends its triangles to the other ranks (default: every rank loads it "
                  "from its path)");
-    add_timeout_option(cmd, distributed::kDefaultRankTimeout);
+    add_timeout_option(cmd, timeout);
 }
 
 }  // namespace
@@ -74,7 +74,7 @@ void print_error(const std::exception& e) {
 }
 
 void add_render_options(CLI::App& cmd) {
-    add_common_options(cmd);
+    add_common_options(cmd, distributed::kDefaultRankTimeout);
     cmd.add_option("--tile", g_options.tiles.tile, "Tile edge in pixels: rank 0 hands out tiles of T x T pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxImageSide));
@@ -84,7 +84,7 @@ void add_render_options(CLI::App& cmd) {
         ->check(CLI::Range(1, distributed::kMaxAhead));
 }
 
-void add_sweep_options(CLI::App& cmd) { add_common_options(cmd); }
+void add_sweep_options(CLI::App& cmd) { add_common_options(cmd, kLongestRankTimeout); }
 void add_bench_options(CLI::App& cmd) { add_timeout_option(cmd, kLongestRankTimeout); }
 
 void together(const std::function<void()>& step, const std::string& name) { session().together(step, name); }
