@@ -38,6 +38,16 @@ struct BoxRay {
             leave[a] = r.dir_neg[a] ? lo : hi;
         }
     }
+    // The same from a stream's stored ray (bvh_stream.inl): the direction's sign bits in `negative`.
+    BoxRay(const float* o, const float* i, unsigned negative, float near, float m) : tnear(near), margin(m) {
+        for (int a = 0; a < 3; ++a) {
+            org[a] = splat(o[a]);
+            inv[a] = splat(i[a]);
+            const int lo = a * kBvhWidth, hi = (3 + a) * kBvhWidth;
+            enter[a] = negative >> a & 1 ? hi : lo;
+            leave[a] = negative >> a & 1 ? lo : hi;
+        }
+    }
 };
 
 // A node's children met by the ray within [tnear - margin, cull], as a bit mask, with each one's
@@ -67,6 +77,11 @@ struct LeafRay {
     explicit LeafRay(const WatertightRay& r)
         : ox(splat(r.org[r.kx])), oy(splat(r.org[r.ky])), oz(splat(r.org[r.kz])), sx(splat(r.sx)), sy(splat(r.sy)),
           sz(splat(r.sz)), kx(r.kx * kBvhWidth), ky(r.ky * kBvhWidth), kz(r.kz * kBvhWidth) {}
+    // The same from a stream's stored ray: the origin already in the test's axis order (o), the
+    // shear (s) and the axes.
+    LeafRay(const float* o, const float* s, int x, int y, int z)
+        : ox(splat(o[0])), oy(splat(o[1])), oz(splat(o[2])), sx(splat(s[0])), sy(splat(s[1])), sz(splat(s[2])),
+          kx(x * kBvhWidth), ky(y * kBvhWidth), kz(z * kBvhWidth) {}
 };
 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
@@ -277,7 +292,9 @@ inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<
     });
 }
 
+#include "bvh/bvh_stream.inl"
+
 inline const BvhKernels& bvh_kernels(const char* isa) {
-    static const BvhKernels k{&closest_batch, &any_batch, isa};
+    static const BvhKernels k{&closest_batch, &any_batch, &closest_stream_batch, &any_stream_batch, isa};
     return k;
 }
