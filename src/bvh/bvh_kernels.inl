@@ -211,17 +211,17 @@ inline void push_children(const BvhNode& node, unsigned met, F entries, std::uin
     size += __builtin_popcount(met);
 }
 
+// One ray through the subtree of `root` (an inner node's word; 0 is the whole tree's root).
 template <class Query, class Counters>
-bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray, const LeafRay& leaf_ray,
+                       std::uint32_t root, Query& q, Counters& c) {
     // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was met
     // within it, so its stack needs no entry distances and no pop is culled.
     constexpr bool kCulls = !Query::kAnyHit;
-    const BoxRay box_ray(r);
-    const LeafRay leaf_ray(r.watertight);
     std::uint32_t word_stack[kBvhStackSize + kBvhStackSlack];
     float entry_stack[kCulls ? kBvhStackSize + kBvhStackSlack : 1];
     int size = 0;
-    std::uint32_t word = 0;  // the root, an inner node
+    std::uint32_t word = root;
     for (;;) {
         if (BvhNode::is_leaf(word)) {
             if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), leaf_ray, q, c)) return true;
@@ -265,6 +265,11 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
         }
         word = word_stack[size];
     }
+}
+
+template <class Query, class Counters>
+bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+    return traverse_bvh_from(nodes, leaves, BoxRay(r), LeafRay(r.watertight), 0, q, c);
 }
 
 // The answers for a tree without triangles: nothing is hit.

@@ -10,12 +10,20 @@
 // hit has come nearer than its entry into a waiting child is dropped from that child's stream, as the
 // single-ray kernel skips a popped child. An any-hit ray leaves every stream once it is answered.
 //
+// A stream of a few rays (kSingleBelow) goes on as single rays from the node it reached, each with
+// the query it carries, as Embree's hybrid packets fall back to single rays when few lanes are left.
+//
 // The tests are bvh_kernels.inl's, lane for lane, and every ray ends with the hit rule's answer among
 // the triangles of the leaves it reached; a leaf is skipped only when the single-ray kernel would skip
 // it too (it starts past the ray's cull distance), whatever the order. So the answers are exactly
 // the single-ray kernel's, hence brute force's.
 //
 // No include guard: included after bvh_kernels.inl in each instruction set's namespace.
+
+// A stream of at most this many rays goes on as single rays (bvh_kernels.inl) from the node it
+// reached: below it the stream's bookkeeping costs more than the node's shared lines save (Sponza,
+// 2026-12-02, docs/INCOHERENT.md "Ray streams": 0 to 4 lose on diffuse bounces, 8 and 16 win on AO).
+inline constexpr std::uint32_t kSingleBelow = 8;
 
 // A ray of a stream as the node and leaf tests read it: one cache line.
 struct alignas(64) StreamRay {
@@ -113,11 +121,26 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
             }
             continue;
         }
+        if (f.count <= kSingleBelow) {
+            // Too few rays left to share the node's lines: each goes on alone (the single-ray kernel,
+            // from this node), with the query it has carried so far.
+            for (std::uint32_t j = f.begin; j < f.begin + f.count; ++j) {
+                const std::uint32_t k = arena[j].ray;
+                if constexpr (kAny) {
+                    if (done[k]) continue;
+                } else {
+                    if (arena[j].entry > queries[k].cull_t()) continue;
+                }
+                if (traverse_bvh_from(nodes, leaves, rays[k].box(), rays[k].leaf(), f.word, queries[k], c)) done[k] = 1;
+            }
+            continue;
+        }
         const BvhNode& node = nodes[f.word];
         std::uint32_t* met_ray = s.met_ray.data();
         std::uint8_t* met = s.met.data();
         float* met_entry = s.met_entry.data();
-        std::uint32_t m = 0, counts[kBvhWidth] = {};
+        std::uint32_t m = 0;
+        I counts = splat_i(0);  // rays per child (subtracting the lane masks of -1)
         unsigned met_any = 0;
         for (std::uint32_t j = f.begin; j < f.begin + f.count; ++j) {
             const std::uint32_t k = arena[j].ray;
@@ -135,7 +158,7 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
             *reinterpret_cast<FRow*>(met_entry + std::size_t{m} * kBvhWidth) = entry;
             ++m;
             met_any |= hit;
-            for (unsigned b = hit; b; b &= b - 1) ++counts[__builtin_ctz(b)];
+            counts -= met_mask(hit);
         }
         if (m == 0) continue;
         // The children met, farthest first: pushed first, popped last. An any-hit stream takes the
@@ -153,22 +176,26 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
             pushed[n_pushed] = far;
             left &= ~(1u << far);
         }
-        std::uint32_t offset[kBvhWidth], top = f.begin;
-        for (int i = 0; i < n_pushed; ++i) {
-            const int child = pushed[i];
-            offset[child] = top;
-            frames[size++] = {node.child[child], top, counts[child]};
-            top += counts[child];
-        }
-        if (s.arena.size() < top) {
-            s.arena.resize(std::max<std::size_t>(top, 2 * s.arena.size()));
+        std::uint32_t top = f.begin;
+        for (int i = 0; i < n_pushed; ++i) top += static_cast<std::uint32_t>(counts[pushed[i]]);
+        if (s.arena.size() <= top) {  // the compaction below writes one entry past the end
+            s.arena.resize(std::max<std::size_t>(top + 1, 2 * s.arena.size()));
             arena = s.arena.data();
         }
-        for (std::uint32_t r = 0; r < m; ++r)
-            for (unsigned b = met[r]; b; b &= b - 1) {
-                const int child = __builtin_ctz(b);
-                arena[offset[child]++] = {met_ray[r], met_entry[std::size_t{r} * kBvhWidth + child]};
+        // Each child's stream, compacted without a branch on the rays' masks (data-dependent, so
+        // mispredicted on incoherent rays): every ray is written, and the end moves on only past the
+        // ones that met the child.
+        top = f.begin;
+        for (int i = 0; i < n_pushed; ++i) {
+            const int child = pushed[i];
+            frames[size++] = {node.child[child], top, static_cast<std::uint32_t>(counts[child])};
+            std::uint32_t end = top;
+            for (std::uint32_t r = 0; r < m; ++r) {
+                arena[end] = {met_ray[r], met_entry[std::size_t{r} * kBvhWidth + child]};
+                end += met[r] >> child & 1u;
             }
+            top = end;
+        }
     }
 }
 
