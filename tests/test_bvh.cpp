@@ -276,21 +276,44 @@ TEST(Routed, PickerTakesThePathThatTookLessTime) {
     EXPECT_EQ(picker.pick(1).path, 0);
 }
 
-// With the streams, three paths: the fastest of the three, sampled rarely only when both others are
-// clearly slower, each path's time clamped against the cheapest.
+// With the streams, three paths: the packets and one partner per sample, the partners by turns (the
+// single rays and the streams are never timed one after the other on the same rays); each partner's
+// cost is its time over the packets' on its own samples, and the route takes the cheapest, sampling
+// rarely only when both others are clearly dearer.
 TEST(Routed, PickerChoosesAmongThreePaths) {
     using detail::RoutePicker;
     RoutePicker picker(3);
     EXPECT_EQ(picker.paths(), 3);
     for (std::uint64_t i = 0; i <= RoutePicker::kPrior; ++i) EXPECT_EQ(picker.pick(1).path, 1);  // the prior
-    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) picker.record(3.0, 2.0, 1.0);
+    int partners[3] = {};
+    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
+        const RoutePicker::Choice c = picker.pick(1);
+        ++partners[c.partner];
+        // Batches of different sizes: the packets take 3 units, the single rays 2, the streams 1.
+        const double size = 1.0 + static_cast<double>(i % 5);
+        picker.record(c.partner, 3.0 * size, (c.partner == 1 ? 2.0 : 1.0) * size);
+    }
+    EXPECT_EQ(partners[1], partners[2]);  // by turns
+    EXPECT_NEAR(picker.cost(1), 2.0 / 3.0, 1e-9);
+    EXPECT_NEAR(picker.cost(2), 1.0 / 3.0, 1e-9);
     EXPECT_EQ(picker.pick(0).path, 2);
     EXPECT_EQ(picker.pick(1).path, 2);
-    // 16 + 16 (100 clamped to 8 times the cheapest) = 32 against 32 + 3 = 35 and 48 + 2 = 50: still the streams.
-    picker.record(2.0, 3.0, 100.0);
-    EXPECT_EQ(picker.pick(1).path, 2);
-    for (int i = 0; i < 40; ++i) picker.record(1.0, 3.0, 2.0);
-    EXPECT_EQ(picker.pick(1).path, 0);
+    // A preempted batch counts at most kClamp times the packets' time.
+    const double streams = picker.seconds(2), packets = picker.packet_seconds(2);
+    picker.record(2, 1.0, 1000.0);
+    EXPECT_EQ(picker.seconds(2) - streams, RoutePicker::kClamp);
+    EXPECT_EQ(picker.packet_seconds(2) - packets, 1.0);
+    for (int i = 0; i < 40; ++i) picker.record(2, 1.0, 3.0);
+    EXPECT_EQ(picker.pick(2).path, 1);  // the streams now dearer than the single rays
+    for (int i = 0; i < 400; ++i) picker.record(1, 1.0, 3.0);
+    EXPECT_EQ(picker.pick(2).path, 0);  // and both than the packets
+
+    // A partner without samples yet is not chosen, and keeps the choice from being clear.
+    RoutePicker half(3);
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) half.pick(1);
+    half.record(1, 3.0, 1.0);
+    EXPECT_EQ(half.cost(2), 0.0);
+    EXPECT_EQ(half.pick(0).path, 1);
     auto sampled = [](RoutePicker& p, int n) {
         int s = 0;
         for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
@@ -298,8 +321,10 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     };
     RoutePicker close(3), clear(3);
     for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
-        close.record(1.0, 3.0, 1.2);  // one other path close: sampled often
-        clear.record(1.0, 3.0, 2.0);
+        close.record(1, 1.0, 3.0);  // the streams close to the packets: sampled often
+        close.record(2, 1.0, 1.2);
+        clear.record(1, 1.0, 3.0);
+        clear.record(2, 1.0, 2.0);
     }
     EXPECT_NEAR(sampled(close, 64000), 64000 / RoutePicker::kSample, 64000 / RoutePicker::kSample / 4);
     EXPECT_NEAR(sampled(clear, 512000), 512000 / RoutePicker::kSampleFar, 512000 / RoutePicker::kSampleFar / 4);
@@ -341,15 +366,16 @@ TEST(Routed, MeasuredRouteCountsOneTracingPerRay) {
     EXPECT_EQ(counters.rays, frame.primary.size());
 }
 
-// The three paths by name: `auto` holds the streams unless told not to, and only when it measures.
+// The three paths by name: `auto` holds the streams when told to (not by default: its paired samples
+// do not yet choose among three reliably, docs/INCOHERENT.md), and only when it measures.
 TEST(Routed, StreamsAreAThirdPathOfTheMeasuredRoute) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
     auto streams = [&](const std::string& spec) {
         return make_accelerator(scene.triangles, parse_accel_config(spec))->stats().setting("streams").value_or("");
     };
-    EXPECT_EQ(streams("auto"), "on");
-    EXPECT_EQ(streams("auto@streams=off"), "off");
-    EXPECT_EQ(streams("auto@route=coherence"), "off");
+    EXPECT_EQ(streams("auto"), "off");
+    EXPECT_EQ(streams("auto@streams=on"), "on");
+    EXPECT_EQ(streams("auto@streams=on,route=coherence"), "off");
     EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@streams=maybe")), Error);
 }
 
@@ -358,7 +384,7 @@ TEST(Routed, StreamsAreAThirdPathOfTheMeasuredRoute) {
 TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
-    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto"));
+    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto@streams=on"));
     for (int round = 0; round < 3; ++round) {  // enough batches to learn and sample
         std::vector<Hit> hits(ref.rays.size());
         std::vector<std::uint8_t> occluded(ref.rays.size());

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <string>
 
 #include "bvh/bvh_accel.hpp"
@@ -15,6 +16,19 @@ namespace cellrt::detail {
 namespace {
 
 const std::vector<std::string> kTraversals{"auto"};
+
+// The calling thread's CPU time in seconds, for a sample's times: it leaves out the time the system
+// gave other threads meanwhile, which the wall clock counts (on a busy machine a batch of tens of
+// microseconds is often preempted for milliseconds; with three paths a sample holds three chances of
+// it). Where the thread clock is missing, the wall clock.
+double thread_seconds() {
+#if defined(CLOCK_THREAD_CPUTIME_ID)
+    timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+        return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+#endif
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 class RoutedAccelerator final : public Accelerator {
 public:
@@ -57,8 +71,9 @@ private:
     }
 
     // Traces the batch on the path coherence names (the packets or the BVH's single rays) or, when
-    // measured, on the one its kind's picker names; a sampled batch also on every other path (the
-    // first by turns, so that no path always finds the rays in the cache), without its work counted.
+    // measured, on the one its kind's picker names; a sampled batch on the packets and the picker's
+    // partner instead (RoutePicker), its work counted once: on the path chosen when it is one of the
+    // two, else on the partner (the answers are the same).
     // `query` is 0 for closest hits, 1 for any.
     template <class Trace>
     void route(std::span<const Ray> rays, int query, Trace&& trace, TraversalCounters* counters) const {
@@ -69,24 +84,32 @@ private:
         }
         RoutePicker& picker = pickers_[2 * query + prior];
         const RoutePicker::Choice choice = picker.pick(prior);
-        count_rays(query, choice.path, rays.size());
-        if (!choice.sampled) return trace(*paths_[choice.path], counters);
-        double seconds[RoutePicker::kMaxPaths];
-        const int first = static_cast<int>(turn_.fetch_add(1, std::memory_order_relaxed) % unsigned(count_));
-        for (int i = 0; i < count_; ++i) {
-            const int path = (first + i) % count_;
-            const auto start = std::chrono::steady_clock::now();
-            trace(*paths_[path], path == choice.path ? counters : nullptr);
-            seconds[path] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!choice.sampled) {
+            count_rays(query, choice.path, rays.size());
+            return trace(*paths_[choice.path], counters);
         }
-        if (choice.counts) picker.record(seconds);
+        const int counted = choice.path == 0 ? 0 : choice.partner;
+        count_rays(query, counted, rays.size());
+        // The packets and the partner, in either order by turns, so that neither always finds the
+        // rays in the cache (every other pair of turns: the partners alternate on every turn).
+        double seconds[2];
+        const int paths[2] = {0, choice.partner};
+        const unsigned first = turn_.fetch_add(1, std::memory_order_relaxed) >> 1 & 1u;
+        for (const unsigned i : {first, 1u - first}) {
+            const int path = paths[i];
+            const double start = thread_seconds();
+            trace(*paths_[path], path == counted ? counters : nullptr);
+            seconds[i] = thread_seconds() - start;
+        }
+        if (choice.counts) picker.record(choice.partner, seconds[0], seconds[1]);
     }
 
     void count_rays(int query, int path, std::size_t n) const {
         routed_[query][path].fetch_add(n, std::memory_order_relaxed);
     }
     // Which path answered how many rays so far, per query: "closest packets/single/stream, any ..."
-    // as fractions, for the benchmark's report of what the route chose.
+    // as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
+    // was sampled, each path's mean time per sample in microseconds.
     std::string routed() const {
         std::string out;
         for (int q = 0; q < 2; ++q) {
@@ -96,6 +119,17 @@ private:
             for (int p = 0; p < count_; ++p) {
                 char buf[48];
                 std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], sum > 0.0 ? n[p] / sum : 0.0);
+                out += buf;
+            }
+        }
+        static const char* const kKinds[4] = {"closest coherent", "closest incoherent", "any coherent", "any incoherent"};
+        for (int k = 0; k < 4; ++k) {
+            const RoutePicker& picker = pickers_[k];
+            if (picker.samples() == 0) continue;
+            out += std::string("; sampled ") + kKinds[k] + " (" + std::to_string(picker.samples()) + "), time over the packets'";
+            for (int p = 1; p < count_; ++p) {
+                char buf[48];
+                std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], picker.cost(p));
                 out += buf;
             }
         }
@@ -143,9 +177,10 @@ const ParamTable& routed_params() {
          "measured: each kind of batch (closest or any hit, coherent or not) goes to the path that took "
          "less time on a sample of them, traced by all; coherence: by coherence alone, the same path "
          "(and work counts) in every run"},
-        {"streams", choice, "on", 0, 0, {"on", "off"},
+        {"streams", choice, "off", 0, 0, {"on", "off"},
          "on: the measured route also samples the wide BVH's stream traversal (bvh:stream) as a third path "
-         "and takes it for the kinds of batch it traces fastest; off: packets and single rays only"},
+         "and takes it for the kinds of batch it traces fastest (not yet reliable: docs/INCOHERENT.md, "
+         "Ray streams); off: packets and single rays only"},
     };
     return table;
 }
