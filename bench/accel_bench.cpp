@@ -190,6 +190,7 @@ struct Result {
     double build_s = 0, memory_mib = 0, primary_s = 0, shadow_s = 0;
     double build_peak_mib = 0;  // the build's peak resident memory above what the process held before it
     double sah_cost = 0;        // the tree's report; 0 where the structure has none
+    std::string routed;         // `auto`: the share of rays each path answered, per query (its "routed" setting)
     std::size_t differing = 0, differing_secondary = 0;  // answers that differ from the exact ones
     TraversalCounters primary_work, shadow_work;
 };
@@ -295,6 +296,7 @@ std::vector<Result> results_of(std::vector<Entry>& entries, const SceneRays& s) 
         Result& r = e.r;
         r.primary_s = median(e.primary_s);
         r.shadow_s = median(e.shadow_s);
+        r.routed = e.accel->stats().setting("routed").value_or("");  // the warm-up and timed passes
         Answers primary, secondary;
         answer(*e.accel, s.rays.primary, RayKind::primary, s.rays.primary.size(), primary, &r.primary_work);
         answer(*e.accel, s.rays.secondary, s.rays.secondary_kind, s.rays.secondary.size(), secondary, &r.shadow_work);
@@ -349,7 +351,7 @@ void print_table(std::FILE* out, const std::vector<Result>& results, const Rays&
 nlohmann::json json_row(const Scene& scene, int width, int height, const Options& o, const Rays& rays,
                         const Result& r) {
     const TraversalCounters &pw = r.primary_work, &sw = r.shadow_work;
-    return {{"scene", scene.name},
+    nlohmann::json row = {{"scene", scene.name},
             {"config", r.config},
             {"rays", o.ray_kind},
             {"shadow_kind", to_string(rays.secondary_kind)},
@@ -365,6 +367,8 @@ nlohmann::json json_row(const Scene& scene, int width, int height, const Options
                                  {"triangles", per_ray(pw.triangles, pw)}}},
             {"shadow_per_ray", {{"nodes", per_ray(sw.nodes, sw)}, {"leaves", per_ray(sw.leaves, sw)},
                                 {"triangles", per_ray(sw.triangles, sw)}}}};
+    if (!r.routed.empty()) row["routed"] = r.routed;
+    return row;
 }
 
 // One scene: its rays, every configuration built and timed; its table (Markdown) and its JSON rows, as

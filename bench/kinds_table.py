@@ -4,8 +4,12 @@ Embree's fastest configuration in the same run, cellrt's fastest exact configura
 and second-kind rays together, then the second kind alone), named configurations over it, and the
 kd-tree's single-ray path (kd:branched) over rtcIntersect1 on the primary rays.
 
-usage: bench/kinds_table.py PREFIX KIND... [--configs CONFIG...]
+usage: bench/kinds_table.py PREFIX KIND... [--second] [--configs CONFIG...]
        (reads PREFIX_KIND.json for each KIND, e.g. docs/figures/incoherent_zen3/after frame ao)
+
+--second: each named configuration's second kind of rays alone over Embree's fastest on them, after
+its figure for both kinds. A configuration that reports its route (`auto`: the share of rays each
+path answered) gets a second table of those shares.
 """
 import json
 import sys
@@ -28,12 +32,16 @@ def main(argv) -> int:
         print(__doc__, file=sys.stderr)
         return 2
     configs = []
+    second = "--second" in argv
+    argv = [a for a in argv if a != "--second"]
     if "--configs" in argv:
         i = argv.index("--configs")
         argv, configs = argv[:i], argv[i + 1 :]
     prefix, kinds = argv[1], argv[2:]
     head = ["rays", "scene", "Embree's fastest, Mrays/s", "cellrt's fastest ÷ Embree's", "second kind alone"]
-    head += [f"{c} ÷ Embree's" for c in configs] + ["kd:branched ÷ rtcIntersect1, primary"]
+    for c in configs:
+        head += [f"{c} ÷ Embree's"] + ([f"{c}, second kind"] if second else [])
+    head += ["kd:branched ÷ rtcIntersect1, primary"]
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * 2 + "--:|" * (len(head) - 2))
     for kind in kinds:
@@ -50,12 +58,24 @@ def main(argv) -> int:
             cells = [kind, scene, f"{rate(rs[best]) * 1e-6:.2f} ({best})",
                      f"{rate(rs[fastest]) / rate(rs[best]):.2f} ({fastest})",
                      f"{second_rate(rs[fastest_second]) / best_second:.2f} ({fastest_second})"]
-            cells += [f"{rate(rs[c]) / rate(rs[best]):.2f}" if c in rs else "–" for c in configs]
+            for c in configs:
+                cells.append(f"{rate(rs[c]) / rate(rs[best]):.2f}" if c in rs else "–")
+                if second:
+                    cells.append(f"{second_rate(rs[c]) / best_second:.2f}" if c in rs else "–")
             if "kd:branched" in rs and "embree:single" in rs:
                 cells.append(f"{primary_rate(rs['kd:branched']) / primary_rate(rs['embree:single']):.2f}")
             else:
                 cells.append("–")
             print("| " + " | ".join(cells) + " |")
+    routed = []
+    for kind in kinds:
+        with open(f"{prefix}_{kind}.json", encoding="utf-8") as f:
+            routed += [(kind, r["scene"], r["config"], r["routed"]) for r in json.load(f) if r.get("routed")]
+    if routed:
+        print("\n| rays | scene | config | share of rays per path (primary: closest; second kind: closest or any) |")
+        print("|---|---|---|---|")
+        for row in routed:
+            print("| " + " | ".join(row) + " |")
     return 0
 
 

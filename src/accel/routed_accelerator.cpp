@@ -4,7 +4,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <string>
 
+#include "bvh/bvh_accel.hpp"
 #include "cellrt/accel.hpp"
 #include "kernel/param_reader.hpp"
 
@@ -13,12 +17,27 @@ namespace {
 
 const std::vector<std::string> kTraversals{"auto"};
 
+// The calling thread's CPU time in seconds, for a sample's times: it leaves out the time the system
+// gave other threads meanwhile, which the wall clock counts (on a busy machine a batch of tens of
+// microseconds is often preempted for milliseconds; with three paths a sample holds three chances of
+// it). Where the thread clock is missing, the wall clock.
+double thread_seconds() {
+#if defined(CLOCK_THREAD_CPUTIME_ID)
+    timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+        return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+#endif
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 class RoutedAccelerator final : public Accelerator {
 public:
-    RoutedAccelerator(std::unique_ptr<Accelerator> coherent, std::unique_ptr<Accelerator> incoherent, float threshold,
-                      std::string packets, bool measured)
-        : paths_{std::move(coherent), std::move(incoherent)}, threshold_(threshold), packets_(std::move(packets)),
-          measured_(measured) {}
+    // `stream`, when given, traces `incoherent`'s tree as streams (bvh_with_traversal): a third path.
+    RoutedAccelerator(std::unique_ptr<Accelerator> coherent, std::unique_ptr<Accelerator> incoherent,
+                      std::unique_ptr<Accelerator> stream, float threshold, std::string packets, bool measured)
+        : paths_{std::move(coherent), std::move(incoherent), std::move(stream)}, count_(paths_[2] ? 3 : 2),
+          threshold_(threshold), packets_(std::move(packets)), measured_(measured),
+          pickers_{RoutePicker(count_), RoutePicker(count_), RoutePicker(count_), RoutePicker(count_)} {}
 
     AccelStats stats() const override {
         const AccelStats c = paths_[0]->stats(), i = paths_[1]->stats();
@@ -28,11 +47,13 @@ public:
         s.simd_lanes = c.simd_lanes;
         s.build_seconds = c.build_seconds + i.build_seconds;
         s.build_cpu_seconds = c.build_cpu_seconds + i.build_cpu_seconds;
-        s.memory_bytes = c.memory_bytes + i.memory_bytes;
+        s.memory_bytes = c.memory_bytes + i.memory_bytes;  // the streams trace the BVH's own tree
         s.triangles = c.triangles;
         s.settings = {{"packets", packets_},
                       {"coherence", param_number(threshold_)},
-                      {"route", measured_ ? "measured" : "coherence"}};
+                      {"route", measured_ ? "measured" : "coherence"},
+                      {"streams", paths_[2] ? "on" : "off"},
+                      {"routed", routed()}};
         return s;
     }
 
@@ -49,33 +70,82 @@ private:
         route(rays, 1, [&](const Accelerator& a, TraversalCounters* c) { a.occluded(rays, occluded, c); }, counters);
     }
 
-    // Traces the batch on the path coherence names or, when measured, on the one its kind's picker
-    // names; a sampled batch also on the other path (first or second by turns, so that neither always
-    // finds the rays in the cache), without its work counted. `query` is 0 for closest hits, 1 for any.
+    // Traces the batch on the path coherence names (the packets or the BVH's single rays) or, when
+    // measured, on the one its kind's picker names; a sampled batch on the packets and the picker's
+    // partner instead (RoutePicker), its work counted once: on the path chosen when it is one of the
+    // two, else on the partner (the answers are the same).
+    // `query` is 0 for closest hits, 1 for any.
     template <class Trace>
     void route(std::span<const Ray> rays, int query, Trace&& trace, TraversalCounters* counters) const {
         const int prior = batch_coherence(rays) >= threshold_ ? 0 : 1;
-        if (!measured_ || rays.size() < kMeasuredBatch) return trace(*paths_[prior], counters);
+        if (!measured_ || rays.size() < kMeasuredBatch) {
+            count_rays(query, prior, rays.size());
+            return trace(*paths_[prior], counters);
+        }
         RoutePicker& picker = pickers_[2 * query + prior];
         const RoutePicker::Choice choice = picker.pick(prior);
-        if (!choice.sampled) return trace(*paths_[choice.path], counters);
-        double seconds[2];
-        const int first = turn_.fetch_add(1, std::memory_order_relaxed) & 1;
-        for (const int path : {first, 1 - first}) {
-            const auto start = std::chrono::steady_clock::now();
-            trace(*paths_[path], path == choice.path ? counters : nullptr);
-            seconds[path] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!choice.sampled) {
+            count_rays(query, choice.path, rays.size());
+            return trace(*paths_[choice.path], counters);
         }
-        if (choice.counts) picker.record(seconds[0], seconds[1]);
+        const int counted = choice.path == 0 ? 0 : choice.partner;
+        count_rays(query, counted, rays.size());
+        // The packets and the partner, in either order by turns, so that neither always finds the
+        // rays in the cache (every other pair of turns: the partners alternate on every turn).
+        double seconds[2];
+        const int paths[2] = {0, choice.partner};
+        const unsigned first = turn_.fetch_add(1, std::memory_order_relaxed) >> 1 & 1u;
+        for (const unsigned i : {first, 1u - first}) {
+            const int path = paths[i];
+            const double start = thread_seconds();
+            trace(*paths_[path], path == counted ? counters : nullptr);
+            seconds[i] = thread_seconds() - start;
+        }
+        if (choice.counts) picker.record(choice.partner, seconds[0], seconds[1]);
     }
 
-    std::unique_ptr<Accelerator> paths_[2];  // the packets, the BVH
+    void count_rays(int query, int path, std::size_t n) const {
+        routed_[query][path].fetch_add(n, std::memory_order_relaxed);
+    }
+    // Which path answered how many rays so far, per query: "closest packets/single/stream, any ..."
+    // as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
+    // was sampled, each path's mean time per sample in microseconds.
+    std::string routed() const {
+        std::string out;
+        for (int q = 0; q < 2; ++q) {
+            double n[3], sum = 0.0;
+            for (int p = 0; p < 3; ++p) sum += n[p] = static_cast<double>(routed_[q][p].load(std::memory_order_relaxed));
+            out += q ? "; any" : "closest";
+            for (int p = 0; p < count_; ++p) {
+                char buf[48];
+                std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], sum > 0.0 ? n[p] / sum : 0.0);
+                out += buf;
+            }
+        }
+        static const char* const kKinds[4] = {"closest coherent", "closest incoherent", "any coherent", "any incoherent"};
+        for (int k = 0; k < 4; ++k) {
+            const RoutePicker& picker = pickers_[k];
+            if (picker.samples() == 0) continue;
+            out += std::string("; sampled ") + kKinds[k] + " (" + std::to_string(picker.samples()) + "), time over the packets'";
+            for (int p = 1; p < count_; ++p) {
+                char buf[48];
+                std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], picker.cost(p));
+                out += buf;
+            }
+        }
+        return out;
+    }
+    static constexpr const char* kPathNames[3] = {"packets", "single", "stream"};
+
+    std::unique_ptr<Accelerator> paths_[3];  // the packets, the BVH's single rays, its streams (or null)
+    int count_;                              // paths in use: 2, or 3 with streams
     float threshold_;
     std::string packets_;
     bool measured_;
     // One per kind of batch: closest or any hit, coherent or not.
     mutable std::array<RoutePicker, 4> pickers_;
     mutable std::atomic<unsigned> turn_{0};
+    mutable std::atomic<std::uint64_t> routed_[2][3]{};  // rays answered, per query and path
 };
 
 }  // namespace
@@ -105,8 +175,12 @@ const ParamTable& routed_params() {
          "any other to the wide BVH (with route=measured: the first guess for its kind of batch)"},
         {"route", choice, "measured", 0, 0, {"measured", "coherence"},
          "measured: each kind of batch (closest or any hit, coherent or not) goes to the path that took "
-         "less time on a sample of them, traced by both; coherence: by coherence alone, the same path "
+         "less time on a sample of them, traced by all; coherence: by coherence alone, the same path "
          "(and work counts) in every run"},
+        {"streams", choice, "off", 0, 0, {"on", "off"},
+         "on: the measured route also samples the wide BVH's stream traversal (bvh:stream) as a third path "
+         "and takes it for the kinds of batch it traces fastest (not yet reliable: docs/INCOHERENT.md, "
+         "Ray streams); off: packets and single rays only"},
     };
     return table;
 }
@@ -118,6 +192,7 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     const std::string packets = params.choice("packets");
     const auto threshold = static_cast<float>(params.number("coherence"));
     const bool measured = params.choice("route") == "measured";
+    const bool streams = params.choice("streams") == "on";
     params.finish();
     choose_traversal(kTraversals, config.traversal, "auto");
     AccelConfig part;
@@ -126,7 +201,10 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     part.kind = packets;
     std::unique_ptr<Accelerator> coherent = make_accelerator(triangles, part);
     part.kind = "bvh";
-    return std::make_unique<RoutedAccelerator>(std::move(coherent), make_accelerator(triangles, part), threshold,
+    std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, part);
+    // Coherence alone never names the streams, so only the measured route holds them.
+    std::unique_ptr<Accelerator> stream = streams && measured ? bvh_with_traversal(*bvh, "stream") : nullptr;
+    return std::make_unique<RoutedAccelerator>(std::move(coherent), std::move(bvh), std::move(stream), threshold,
                                                packets, measured);
 }
 

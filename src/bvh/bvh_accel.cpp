@@ -10,31 +10,36 @@ namespace {
 class BvhAccelerator final : public Accelerator {
 public:
     BvhAccelerator(std::span<const Triangle> triangles, const detail::BvhBuildOptions& options,
-                   const detail::BvhKernels& kernels)
-        : options_(options), kernels_(kernels), triangle_count_(triangles.size()) {
+                   const detail::BvhKernels& kernels, bool stream)
+        : options_(options), kernels_(kernels), stream_(stream), triangle_count_(triangles.size()) {
         const Timer timer;
         tree_ = detail::build_bvh(triangles, options);
         build_seconds_ = timer.seconds();
         build_cpu_seconds_ = timer.cpu_seconds();
     }
 
+    // A view of `other`'s tree traced by the given traversal (bvh_with_traversal).
+    BvhAccelerator(const BvhAccelerator& other, bool stream)
+        : options_(other.options_), kernels_(other.kernels_), stream_(stream), triangle_count_(other.triangle_count_),
+          shared_(&other.tree()) {}
+
     AccelStats stats() const override {
         AccelStats s;
         s.name = "bvh";
-        s.traversal = "wide";
+        s.traversal = stream_ ? "stream" : "wide";
         s.build_seconds = build_seconds_;
         s.build_cpu_seconds = build_cpu_seconds_;
-        s.memory_bytes = tree_.nodes.size() * sizeof(detail::BvhNode) + tree_.leaves.size() * sizeof(detail::BvhLeaf);
+        s.memory_bytes = tree().nodes.size() * sizeof(detail::BvhNode) + tree().leaves.size() * sizeof(detail::BvhLeaf);
         s.triangles = triangle_count_;
         TreeReport r;
-        r.nodes = tree_.nodes.size() + tree_.leaves.size();
-        r.inner_nodes = tree_.nodes.size();
-        r.leaves = tree_.leaves.size();
-        r.max_depth = tree_.depth;
-        r.mean_leaf_depth = tree_.mean_leaf_depth;
-        r.triangles_per_leaf = tree_.mean_leaf_triangles;
+        r.nodes = tree().nodes.size() + tree().leaves.size();
+        r.inner_nodes = tree().nodes.size();
+        r.leaves = tree().leaves.size();
+        r.max_depth = tree().depth;
+        r.mean_leaf_depth = tree().mean_leaf_depth;
+        r.triangles_per_leaf = tree().mean_leaf_triangles;
         r.references_per_triangle = triangle_count_ ? 1.0 : 0.0;
-        r.sah_cost = tree_.sah_cost;
+        r.sah_cost = tree().sah_cost;
         s.tree = r;
         s.settings = {{"bins", std::to_string(options_.bins)},
                       {"max_leaf", std::to_string(options_.max_leaf)},
@@ -46,21 +51,32 @@ public:
 
 private:
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        kernels_.closest(tree_, rays, hits, counters);
+        (stream_ ? kernels_.stream_closest : kernels_.closest)(tree(), rays, hits, counters);
     }
     void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                      TraversalCounters* counters) const override {
-        kernels_.any(tree_, rays, occluded, counters);
+        (stream_ ? kernels_.stream_any : kernels_.any)(tree(), rays, occluded, counters);
     }
+
+    const detail::BvhTree& tree() const { return shared_ ? *shared_ : tree_; }
 
     detail::BvhBuildOptions options_;
     const detail::BvhKernels& kernels_;
+    bool stream_;  // the stream traversal, not single rays
     std::size_t triangle_count_;
     detail::BvhTree tree_;
+    const detail::BvhTree* shared_ = nullptr;  // a view's tree, owned by the accelerator it was made from
     double build_seconds_ = 0.0, build_cpu_seconds_ = 0.0;
 };
 
 }  // namespace
+
+std::unique_ptr<Accelerator> detail::bvh_with_traversal(const Accelerator& bvh, const std::string& traversal) {
+    const auto* b = dynamic_cast<const BvhAccelerator*>(&bvh);
+    if (!b) throw Error("bvh_with_traversal: not a wide BVH");
+    const bool stream = detail::choose_traversal(bvh_traversals(), traversal, "bvh") == "stream";
+    return std::unique_ptr<Accelerator>(new BvhAccelerator(*b, stream));
+}
 
 const ParamTable& bvh_params() {
     using enum ParamType;
@@ -77,7 +93,7 @@ const ParamTable& bvh_params() {
 // A function's static, not a namespace-scope one: the registry copies the list when it is first used,
 // which may be during another unit's static initialisation (a test's list of configurations).
 const std::vector<std::string>& bvh_traversals() {
-    static const std::vector<std::string> names{"wide"};
+    static const std::vector<std::string> names{"wide", "stream"};
     return names;
 }
 
@@ -90,8 +106,8 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.traversal_cost = params.number("traversal_cost");
     options.intersection_cost = params.number("intersection_cost");
     params.finish();
-    detail::choose_traversal(bvh_traversals(), config.traversal, "bvh");
-    return std::make_unique<BvhAccelerator>(triangles, options, kernels);
+    const bool stream = detail::choose_traversal(bvh_traversals(), config.traversal, "bvh") == "stream";
+    return std::make_unique<BvhAccelerator>(triangles, options, kernels, stream);
 }
 
 }  // namespace cellrt

@@ -3,7 +3,8 @@
 // a node's children and a leaf's triangles. Exact under the hit rule, like the trees.
 //
 // Build parameters: bvh_params(). The build runs on one thread (AccelConfig::threads is not used).
-// Traversals: "wide" (the one). The kernels come from the registry, compiled for the instruction set
+// Traversals: "wide" (single rays, the default) and "stream" (the batch's rays down the tree
+// together, bvh_stream.inl: each node read once per stream). The kernels come from the registry, compiled for the instruction set
 // AccelConfig::simd names (registry: bvh_kernels_for; eight lanes in every set).
 #pragma once
 
@@ -21,6 +22,13 @@ namespace cellrt {
 std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const AccelConfig& config,
                                       const detail::BvhKernels& kernels);
 const ParamTable& bvh_params();
+
+namespace detail {
+// The tree of `bvh` (an accelerator make_bvh made) traced by `traversal`, without a second build:
+// the view reads `bvh`'s tree, so `bvh` must outlive it. Throws cellrt::Error for another kind of
+// accelerator or an unknown traversal. (The router's paths share one tree: routed_accelerator.cpp.)
+std::unique_ptr<Accelerator> bvh_with_traversal(const Accelerator& bvh, const std::string& traversal);
+}  // namespace detail
 const std::vector<std::string>& bvh_traversals();
 
 }  // namespace cellrt

@@ -18,6 +18,9 @@ namespace cellrt::detail {
 struct BvhKernels {
     void (*closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+    // The stream traversal (bvh_stream.inl): the batch's rays down the tree together.
+    void (*stream_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*stream_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
     const char* isa;  // the instruction set they are compiled for
 };
 

@@ -38,6 +38,16 @@ struct BoxRay {
             leave[a] = r.dir_neg[a] ? lo : hi;
         }
     }
+    // The same from a stream's stored ray (bvh_stream.inl): the direction's sign bits in `negative`.
+    BoxRay(const float* o, const float* i, unsigned negative, float near, float m) : tnear(near), margin(m) {
+        for (int a = 0; a < 3; ++a) {
+            org[a] = splat(o[a]);
+            inv[a] = splat(i[a]);
+            const int lo = a * kBvhWidth, hi = (3 + a) * kBvhWidth;
+            enter[a] = negative >> a & 1 ? hi : lo;
+            leave[a] = negative >> a & 1 ? lo : hi;
+        }
+    }
 };
 
 // A node's children met by the ray within [tnear - margin, cull], as a bit mask, with each one's
@@ -67,6 +77,11 @@ struct LeafRay {
     explicit LeafRay(const WatertightRay& r)
         : ox(splat(r.org[r.kx])), oy(splat(r.org[r.ky])), oz(splat(r.org[r.kz])), sx(splat(r.sx)), sy(splat(r.sy)),
           sz(splat(r.sz)), kx(r.kx * kBvhWidth), ky(r.ky * kBvhWidth), kz(r.kz * kBvhWidth) {}
+    // The same from a stream's stored ray: the origin already in the test's axis order (o), the
+    // shear (s) and the axes.
+    LeafRay(const float* o, const float* s, int x, int y, int z)
+        : ox(splat(o[0])), oy(splat(o[1])), oz(splat(o[2])), sx(splat(s[0])), sy(splat(s[1])), sz(splat(s[2])),
+          kx(x * kBvhWidth), ky(y * kBvhWidth), kz(z * kBvhWidth) {}
 };
 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
@@ -196,17 +211,17 @@ inline void push_children(const BvhNode& node, unsigned met, F entries, std::uin
     size += __builtin_popcount(met);
 }
 
+// One ray through the subtree of `root` (an inner node's word; 0 is the whole tree's root).
 template <class Query, class Counters>
-bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray, const LeafRay& leaf_ray,
+                       std::uint32_t root, Query& q, Counters& c) {
     // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was met
     // within it, so its stack needs no entry distances and no pop is culled.
     constexpr bool kCulls = !Query::kAnyHit;
-    const BoxRay box_ray(r);
-    const LeafRay leaf_ray(r.watertight);
     std::uint32_t word_stack[kBvhStackSize + kBvhStackSlack];
     float entry_stack[kCulls ? kBvhStackSize + kBvhStackSlack : 1];
     int size = 0;
-    std::uint32_t word = 0;  // the root, an inner node
+    std::uint32_t word = root;
     for (;;) {
         if (BvhNode::is_leaf(word)) {
             if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), leaf_ray, q, c)) return true;
@@ -252,6 +267,11 @@ bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRa
     }
 }
 
+template <class Query, class Counters>
+bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
+    return traverse_bvh_from(nodes, leaves, BoxRay(r), LeafRay(r.watertight), 0, q, c);
+}
+
 // The answers for a tree without triangles: nothing is hit.
 template <class Answer>
 void miss_all(std::span<const Ray> rays, std::span<Answer> out, TraversalCounters* counters) {
@@ -277,7 +297,9 @@ inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<
     });
 }
 
+#include "bvh/bvh_stream.inl"
+
 inline const BvhKernels& bvh_kernels(const char* isa) {
-    static const BvhKernels k{&closest_batch, &any_batch, isa};
+    static const BvhKernels k{&closest_batch, &any_batch, &closest_stream_batch, &any_stream_batch, isa};
     return k;
 }
