@@ -545,11 +545,23 @@ private:
     // its box cut to each child cell (every ancestor cell contains the child cell, so the cut needs
     // no earlier box).
     std::pair<Box3, Box3> child_boxes(std::uint32_t tri, const Box3& cell, const Split& s) const {
-        if (p_.perfect_splits) return clipped_child_bounds(tris_[tri], cell, s.axis, s.pos);
+        const Box3 b = tris_[tri].bounds();
+        if (p_.perfect_splits && clip_pays(intersection(b, cell), cell, s.axis))
+            return clipped_child_bounds(tris_[tri], cell, s.axis, s.pos);
         Box3 lcell = cell, rcell = cell;
         lcell.hi[s.axis] = rcell.lo[s.axis] = s.pos;
-        const Box3 b = tris_[tri].bounds();
         return {intersection(b, lcell), intersection(b, rcell)};
+    }
+
+    // Whether clipping a straddler whose box within the cell is `b` may tighten its children's boxes
+    // by enough to pay: only where the box spans at least `clip_ratio` of the cell on an axis other
+    // than the split axis. A triangle small against the cell gains little from clipping (its cut box
+    // is nearly as tight; Wald & Havran 2006, section 4.1, on what perfect splits buy), and those are
+    // most straddlers of large cells. `clip_ratio` 0 clips every straddler.
+    bool clip_pays(const Box3& b, const Box3& cell, int axis) const {
+        for (int a = 0; a < 3; ++a)
+            if (a != axis && !(b.hi[a] - b.lo[a] < p_.clip_ratio * (cell.hi[a] - cell.lo[a]))) return true;
+        return false;
     }
 
     // Where a split writes the children's references or events (grown, never shrunk).
