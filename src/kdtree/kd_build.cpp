@@ -11,8 +11,9 @@
 // choice, ties included, is exactly the full sweep's, so the tree is the one W&H's sweep builds, at
 // the price of one binning pass, a few gathering passes and small sorts per node. Straddling
 // triangles are clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes
-// are tight; references are partitioned into per-thread buffers indexed by depth, so that no node
-// allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest candidate: kd_sah.hpp.
+// are tight, where that pays (clip_ratio: those small against the cell get their box cut to the
+// child cells instead); references are partitioned into per-thread buffers indexed by depth, so
+// that no node allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest candidate: kd_sah.hpp.
 //
 // Parallelism: the two children of a large node are built as separate tasks, each into its own node
 // array; a final pass lays the pieces out depth-first. The layout depends only on the tree, never on
