@@ -13,7 +13,8 @@
 // triangles are clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes
 // are tight, where that pays (clip_ratio: those small against the cell get their box cut to the
 // child cells instead); references are partitioned into per-thread buffers indexed by depth, so
-// that no node allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest candidate: kd_sah.hpp.
+// that no node allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest
+// candidate: kd_sah.hpp.
 //
 // Parallelism: the two children of a large node are built as separate tasks, each into its own node
 // array; a final pass lays the pieces out depth-first. The layout depends only on the tree, never on
@@ -554,11 +555,11 @@ private:
         return {intersection(b, lcell), intersection(b, rcell)};
     }
 
-    // Whether clipping a straddler whose box within the cell is `b` may tighten its children's boxes
-    // by enough to pay: only where the box spans at least `clip_ratio` of the cell on an axis other
-    // than the split axis. A triangle small against the cell gains little from clipping (its cut box
-    // is nearly as tight; Wald & Havran 2006, section 4.1, on what perfect splits buy), and those are
-    // most straddlers of large cells. `clip_ratio` 0 clips every straddler.
+    // Whether to clip (perfect splits, Wald & Havran 2006, section 4.1) a straddler whose box within
+    // the cell is `b`: only where the box spans at least `clip_ratio` of the cell on an axis other
+    // than the split axis. For a triangle small against the cell the cut box is nearly as tight as
+    // the clipped one (this rule and its default are measured in docs/BUILD_SPEED.md, not taken
+    // from the paper). `clip_ratio` 0 clips every straddler.
     bool clip_pays(const Box3& b, const Box3& cell, int axis) const {
         for (int a = 0; a < 3; ++a)
             if (a != axis && !(b.hi[a] - b.lo[a] < p_.clip_ratio * (cell.hi[a] - cell.lo[a]))) return true;
