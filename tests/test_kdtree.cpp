@@ -33,6 +33,7 @@ TEST(KdTree, BuildVariantsMatchBruteForce) {
         {{"method", "binned"}, {"bins", "16"}},
         {{"method", "sweep"}},
         {{"perfect_splits", "false"}},
+        {{"clip_ratio", "0.5"}},
         {{"retract", "false"}, {"leaf_size", "1"}},
         {{"max_depth", "3"}},
         {{"empty_bonus", "0.9"}, {"traversal_cost", "1"}, {"intersection_cost", "80"}},
@@ -91,6 +92,20 @@ TEST(KdTree, SameTreeBytesAtAnyThreadCount) {
         }
 }
 
+// The defaults clip only straddlers not small against their cell (clip_ratio) and allow no bad
+// refinements; their trees must cost, by the SAH, at most 2% more than the exact rules' (perfect
+// splits for every straddler, Mitsuba's three bad refinements: the trees before issue 22).
+TEST(KdTree, DefaultTreeWithinTwoPercentOfTheExactSahCost) {
+    for (const char* name : {"teapot", "bunny", "sponza", "sibenik"}) {
+        CELLRT_REQUIRE_SHARED_SCENE(path, name);
+        const Scene& scene = test::cached_scene(path);
+        const AccelConfig exact_rules = kd("", {{"clip_ratio", "0"}, {"max_bad_refines", "3"}});
+        const double exact = make_accelerator(scene.triangles, exact_rules)->stats().tree->sah_cost;
+        const double fast = make_accelerator(scene.triangles, kd(""))->stats().tree->sah_cost;
+        EXPECT_LE(fast, 1.02 * exact) << name;
+    }
+}
+
 TEST(KdTree, ReportsItsBuild) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const AccelStats s = make_accelerator(scene.triangles, kd(""))->stats();
@@ -131,7 +146,8 @@ TEST(KdTree, RejectsBadParameters) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
     for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
              {"traversal_cost", "-1"}, {"intersection_cost", "x"}, {"empty_bonus", "1"}, {"max_depth", "99"},
-             {"method", "octree"}, {"bins", "2"}, {"perfect_splits", "maybe"}, {"no_such", "1"}})
+             {"method", "octree"}, {"bins", "2"}, {"perfect_splits", "maybe"}, {"clip_ratio", "1.5"},
+             {"no_such", "1"}})
         EXPECT_THROW(make_accelerator(scene.triangles, kd("", {{k, v}})), Error) << k << "=" << v;
     EXPECT_THROW(make_accelerator(scene.triangles, kd("stackless")), Error);
 }

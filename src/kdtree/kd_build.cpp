@@ -11,8 +11,10 @@
 // choice, ties included, is exactly the full sweep's, so the tree is the one W&H's sweep builds, at
 // the price of one binning pass, a few gathering passes and small sorts per node. Straddling
 // triangles are clipped to each child cell ("perfect splits", W&H section 4.1) so that child boxes
-// are tight; references are partitioned into per-thread buffers indexed by depth, so that no node
-// allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest candidate: kd_sah.hpp.
+// are tight, where that pays (clip_ratio: those small against the cell get their box cut to the
+// child cells instead); references are partitioned into per-thread buffers indexed by depth, so
+// that no node allocates. Clipping: kd_clip.hpp; the SAH and the search for the cheapest
+// candidate: kd_sah.hpp.
 //
 // Parallelism: the two children of a large node are built as separate tasks, each into its own node
 // array; a final pass lays the pieces out depth-first. The layout depends only on the tree, never on
@@ -545,11 +547,23 @@ private:
     // its box cut to each child cell (every ancestor cell contains the child cell, so the cut needs
     // no earlier box).
     std::pair<Box3, Box3> child_boxes(std::uint32_t tri, const Box3& cell, const Split& s) const {
-        if (p_.perfect_splits) return clipped_child_bounds(tris_[tri], cell, s.axis, s.pos);
+        const Box3 b = tris_[tri].bounds();
+        if (p_.perfect_splits && clip_pays(intersection(b, cell), cell, s.axis))
+            return clipped_child_bounds(tris_[tri], cell, s.axis, s.pos);
         Box3 lcell = cell, rcell = cell;
         lcell.hi[s.axis] = rcell.lo[s.axis] = s.pos;
-        const Box3 b = tris_[tri].bounds();
         return {intersection(b, lcell), intersection(b, rcell)};
+    }
+
+    // Whether to clip (perfect splits, Wald & Havran 2006, section 4.1) a straddler whose box within
+    // the cell is `b`: only where the box spans at least `clip_ratio` of the cell on an axis other
+    // than the split axis. For a triangle small against the cell the cut box is nearly as tight as
+    // the clipped one (this rule and its default are measured in docs/BUILD_SPEED.md, not taken
+    // from the paper). `clip_ratio` 0 clips every straddler.
+    bool clip_pays(const Box3& b, const Box3& cell, int axis) const {
+        for (int a = 0; a < 3; ++a)
+            if (a != axis && !(b.hi[a] - b.lo[a] < p_.clip_ratio * (cell.hi[a] - cell.lo[a]))) return true;
+        return false;
     }
 
     // Where a split writes the children's references or events (grown, never shrunk).

@@ -39,6 +39,9 @@ const ParamTable& KdStructure::param_table() {
              "bins per axis of min-max binning (Mitsuba's default)"},
             {"perfect_splits", boolean, text(d.perfect_splits), 0, 0, {},
              "clip straddling triangles to the child cells"},
+            {"clip_ratio", number, text(d.clip_ratio), 0.0, 1.0, {},
+             "with perfect splits, clip only straddlers whose box spans at least this fraction of the cell on an "
+             "axis other than the split axis (others: their box cut to each child cell); 0 clips all"},
             {"retract", boolean, text(d.retract), 0, 0, {}, "replace subtrees no cheaper than a leaf by the leaf"},
             {"max_bad_refines", integer, text(double(d.max_bad_refines)), 0, 64, {},
              "the bad-refinement rule's allowance per path"},
@@ -60,6 +63,7 @@ KdBuildParams read_kd_params(const AccelConfig& config) {
     p.sweep_below = in.integer("sweep_below");
     p.bins = in.integer("bins");
     p.perfect_splits = in.boolean("perfect_splits");
+    p.clip_ratio = in.number("clip_ratio");
     p.retract = in.boolean("retract");
     p.max_bad_refines = in.integer("max_bad_refines");
     p.threads = config.threads;
