@@ -21,6 +21,9 @@ typedef std::uint32_t URow __attribute__((vector_size(4 * kLanes), aligned(4), m
 inline F load(const float* p) { return *reinterpret_cast<const FRow*>(p); }
 inline U load_u(const std::uint32_t* p) { return *reinterpret_cast<const URow*>(p); }
 
+// The direction's sign bits (x, y, z in bits 0-2), as TraversalRay::dir_neg holds them: the octant.
+inline unsigned octant_bits(const TraversalRay& r) { return r.dir_neg[0] | r.dir_neg[1] << 1 | r.dir_neg[2] << 2; }
+
 // The ray as the box tests of every node see it: its origin and reciprocal direction in all lanes,
 // its tnear and margin, and for each axis the offset (in floats, from the node's lo[0]) of the planes
 // it enters and leaves a box by, chosen once by the direction's sign.
@@ -29,17 +32,11 @@ struct BoxRay {
     float tnear, margin;
     int enter[3], leave[3];
 
-    explicit BoxRay(const TraversalRay& r) : tnear(r.tnear), margin(r.margin) {
-        for (int a = 0; a < 3; ++a) {
-            org[a] = splat(r.org[a]);
-            inv[a] = splat(r.inv_dir[a]);
-            const int lo = a * kBvhWidth, hi = (3 + a) * kBvhWidth;
-            enter[a] = r.dir_neg[a] ? hi : lo;
-            leave[a] = r.dir_neg[a] ? lo : hi;
-        }
-    }
-    // The same from a stream's stored ray (bvh_stream.inl): the direction's sign bits in `negative`.
-    BoxRay(const float* o, const float* i, unsigned negative, float near, float m) : tnear(near), margin(m) {
+    explicit BoxRay(const TraversalRay& r) : BoxRay(r.org, r.inv_dir, octant_bits(r), r.tnear, r.margin) {}
+    // From the origin and reciprocal direction (anything indexed by axis: a stream's stored ray,
+    // bvh_stream.inl, keeps them as floats) and the direction's sign bits.
+    template <class Origin, class Inverse>
+    BoxRay(const Origin& o, const Inverse& i, unsigned negative, float near, float m) : tnear(near), margin(m) {
         for (int a = 0; a < 3; ++a) {
             org[a] = splat(o[a]);
             inv[a] = splat(i[a]);

@@ -47,7 +47,7 @@ struct alignas(64) StreamRay {
         shear[0] = w.sx;
         shear[1] = w.sy;
         shear[2] = w.sz;
-        code = r.dir_neg[0] | r.dir_neg[1] << 1 | r.dir_neg[2] << 2 | std::uint32_t(w.kx) << 3 |
+        code = octant_bits(r) | std::uint32_t(w.kx) << 3 |
                std::uint32_t(w.ky) << 5 | std::uint32_t(w.kz) << 7;
     }
     unsigned octant() const { return code & 7u; }
@@ -232,7 +232,7 @@ std::uint32_t prepare_stream(const BvhTree& tree, std::span<const Ray> rays, Str
     for (std::size_t i = 0; i < n; ++i) {
         if (!is_valid(rays[i])) continue;
         const TraversalRay r(rays[i], tree.bounds);
-        const std::uint32_t k = by_octant ? at[r.dir_neg[0] | r.dir_neg[1] << 1 | r.dir_neg[2] << 2]++ : valid;
+        const std::uint32_t k = by_octant ? at[octant_bits(r)]++ : valid;
         ++valid;
         s.rays[k].set(r);
         s.index[k] = static_cast<std::uint32_t>(i);
