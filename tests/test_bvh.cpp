@@ -250,6 +250,13 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
 
 // The measured route: the prior until a sample is in, then the path with the smaller time over the
 // samples; every batch sampled while it learns, few once it knows, fewer when the choice is clear.
+// How many of the next n batches (coherent by the prior) the picker samples.
+int sampled(detail::RoutePicker& p, int n) {
+    int s = 0;
+    for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
+    return s;
+}
+
 TEST(Routed, PickerTakesThePathThatTookLessTime) {
     using detail::RoutePicker;
     RoutePicker picker;
@@ -314,11 +321,6 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     half.record(1, 3.0, 1.0);
     EXPECT_EQ(half.cost(2), 0.0);
     EXPECT_EQ(half.pick(0).path, 1);
-    auto sampled = [](RoutePicker& p, int n) {
-        int s = 0;
-        for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
-        return s;
-    };
     RoutePicker close(3), clear(3);
     for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
         close.record(1, 1.0, 3.0);  // the streams close to the packets: sampled often
@@ -332,11 +334,6 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
 
 TEST(Routed, PickerSamplesFewBatchesOnceItKnows) {
     using detail::RoutePicker;
-    auto sampled = [](RoutePicker& p, int n) {
-        int s = 0;
-        for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
-        return s;
-    };
     RoutePicker learning;
     EXPECT_EQ(sampled(learning, RoutePicker::kPrior), 0);
     EXPECT_NEAR(sampled(learning, 8000), 8000 / RoutePicker::kLearn, 8000 / RoutePicker::kLearn / 4);
