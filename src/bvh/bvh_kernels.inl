@@ -4,8 +4,9 @@
 //
 // A node: the ray's slab distances to the eight child boxes, widened by the ray's margin
 // (kernel/traversal.hpp) exactly as the scalar clip() widens the scene box, so that a box is missed
-// only when the ray passes it by more than the margin; the children met are visited nearest first,
-// the others pushed with their entry distance and skipped when popped past the query's cull distance.
+// only when the ray passes it by more than the margin; the children met are visited nearest first
+// (an any-hit query: the first met), the others pushed with their entry distance and skipped when
+// popped past the query's cull distance.
 // A leaf: the watertight test (triangle.hpp) of its triangles, lane by lane in the scalar test's
 // operations and order, so each lane's t, u and v are the scalar test's bits; the hit rule then picks
 // among the lanes. Hence the kernels return exactly the hits of brute force.
@@ -226,29 +227,26 @@ bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay
             c.node();
             const BvhNode& node = nodes[word];
             F entry;
-            unsigned met = meet_children(node, box_ray, q.cull_t(), entry);
-            if constexpr (Query::kAnyHit) {
-                // Any hit ends the query, and leaves end it sooner than subtrees: test the leaves
-                // met at once, and go on only into the inner children.
-                const unsigned leaf_children = leaf_lanes(node);
-                for (unsigned leaves_met = met & leaf_children; leaves_met; leaves_met &= leaves_met - 1) {
-                    const std::uint32_t w = node.child[__builtin_ctz(leaves_met)];
-                    if (test_leaf(leaves[BvhNode::leaf_index(w)], BvhNode::leaf_count(w), leaf_ray, q, c)) return true;
-                }
-                met &= ~leaf_children;
-            }
+            const unsigned met = meet_children(node, box_ray, q.cull_t(), entry);
             if (met) {
                 // One child met (the common case deep in the tree): go there. Several: the nearest
                 // goes first, the others wait unsorted (sorting them costs more on incoherent rays
-                // than the order saves, and a popped child past the answer is skipped).
+                // than the order saves, and a popped child past the answer is skipped). An any-hit
+                // query takes the first child met, as Embree's any-hit traversal does: any occluder
+                // answers it, and the next node's address then waits on no lane minimum (measured
+                // faster than the nearest, and than testing the leaves met first:
+                // docs/INCOHERENT.md, "Third round").
                 if ((met & (met - 1)) == 0) {
                     word = node.child[__builtin_ctz(met)];
                     continue;
                 }
-                const F masked = select(met_mask(met), entry, splat(kInfinity));
-                const unsigned nearest = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
-                word = node.child[nearest];
-                push_children(node, met & ~(1u << nearest), entry, word_stack, kCulls ? entry_stack : nullptr, size);
+                unsigned next = __builtin_ctz(met);
+                if constexpr (!Query::kAnyHit) {
+                    const F masked = select(met_mask(met), entry, splat(kInfinity));
+                    next = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
+                }
+                word = node.child[next];
+                push_children(node, met & ~(1u << next), entry, word_stack, kCulls ? entry_stack : nullptr, size);
                 continue;
             }
         }
