@@ -328,11 +328,13 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     EXPECT_EQ(run.paths_seen[1], run.paths_seen[2]);
     EXPECT_EQ(picker.fastest(0), 2);
     EXPECT_EQ(picker.fastest(1), 2);
-    EXPECT_TRUE(picker.clear(2));
+    EXPECT_TRUE(picker.far(0, 2));
+    EXPECT_TRUE(picker.far(1, 2));
     run.per_ray = {3.0, 2.0, 20.0};  // the streams now dearest: their timed runs raise their cost
     run.take(40000, 2);
     EXPECT_EQ(picker.fastest(2), 1);
-    EXPECT_FALSE(picker.clear(1));  // the packets within kFar of the single rays
+    EXPECT_FALSE(picker.far(0, 1));  // the packets within kFar of the single rays
+    EXPECT_TRUE(picker.far(2, 1));
 
     // A path with nothing counted (every batch of its runs a warm-up) is not chosen, and keeps the
     // choice from being clear.
@@ -343,21 +345,27 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     half.record(1, 1.0, 1);
     EXPECT_EQ(half.cost(2), 0.0);
     EXPECT_EQ(half.fastest(0), 1);
-    EXPECT_FALSE(half.clear(1));
+    EXPECT_FALSE(half.far(2, 1));
 }
 
-// How many batches are timed once the picker knows: one run in kSample while another path is close,
-// one in kSampleFar once every other path costs more than kFar times the fastest.
+// Once the picker knows: one run in kSample is timed; a path within kFar of the fastest traces its
+// share of them, one that costs more than kFar times the fastest one in kSampleFar / kSample of
+// that share (the rest go to the fastest, timed).
 TEST(Routed, PickerTimesFewRunsOnceItKnows) {
     using detail::RoutePicker;
     const auto learning = static_cast<int>(RoutePicker::kPrior + 2 * RoutePicker::kLearnRuns * RoutePicker::kRun);
     RoutePicker close, clear;
+    PickerRun near_run{close, {1.0, 1.2}}, far_run{clear, {1.0, 3.0}};
+    EXPECT_EQ(near_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
+    EXPECT_EQ(far_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
     PickerRun near{close, {1.0, 1.2}}, far{clear, {1.0, 3.0}};
-    EXPECT_EQ(near.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
-    EXPECT_EQ(far.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
     const int n = 512000;
     EXPECT_NEAR(near.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
-    EXPECT_NEAR(far.take(n), n / RoutePicker::kSampleFar, n / RoutePicker::kSampleFar / 4);
+    EXPECT_NEAR(far.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
+    const int near_share = n / static_cast<int>(2 * RoutePicker::kSample);
+    const int far_share = n / static_cast<int>(2 * RoutePicker::kSampleFar);
+    EXPECT_NEAR(near.paths_seen[1], near_share, near_share / 4);
+    EXPECT_NEAR(far.paths_seen[1], far_share, far_share / 4);
 }
 
 // Measured or not, the route changes no answer, and the work counted is that of the path that

@@ -37,15 +37,18 @@ const std::vector<std::string>& routed_traversals();
 // neighbouring pixels), but a background tile costs a tenth of one on the object: so while it learns,
 // the picker gives the runs to the paths in turn (each block of `paths` runs one to each path, in an
 // order drawn by a hash of the block), which spreads each path's runs over the same stretch of
-// batches, and a path's cost is its total time over its total rays. The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C
-// or Python caller's one query, pays nothing for the choice. After kLearnRuns runs per path, the
-// fastest path takes every run but one in kSample, chosen by a hash of the run's number (not every
-// n-th, which would sample the same column of a frame's tiles); that run is timed on a path drawn by
-// the hash, the fastest included, so that every estimate keeps up with the workload; one in
-// kSampleFar while every other path costs more than kFar times the fastest (a clear choice costs
-// little). Times are the thread's CPU time, so a batch whose thread the system preempted does not
-// count the other threads' time. Sums are atomics: any number of threads route and record at once,
-// and a race only blurs a figure.
+// batches, and a path's cost is its total time over its total rays.
+//
+// The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
+// Python caller's one query, pays nothing for the choice. After kLearnRuns runs per path, the fastest
+// path takes every run but one in kSample, chosen by a hash of the run's number (not every n-th,
+// which would sample the same column of a frame's tiles); that run is timed on a path drawn by the
+// hash, the fastest included, so that every estimate keeps up with the workload. A path that costs
+// more than kFar times the fastest keeps only one in kSampleFar / kSample of the runs drawn for it
+// (the others go to the fastest, timed): a clear loser costs little, while two paths within kFar of
+// each other are both timed often. Times are the thread's CPU time, so a batch whose thread the
+// system preempted does not count the other threads' time. Sums are atomics: any number of threads
+// route and record at once, and a race only blurs a figure.
 class RoutePicker {
 public:
     static constexpr std::uint64_t kPrior = 8, kRun = 4, kLearnRuns = 8, kSample = 16, kSampleFar = 64;
@@ -83,13 +86,14 @@ public:
             // Each block of `paths` runs gives one to every path, rotated by a hash of the block's
             // number: in turn, but not in step with a frame's rows (two paths taking runs strictly
             // by turns gave one the left half of every row of tiles and the other the right half).
-            const std::uint64_t block = run / paths;
-            return {static_cast<int>((run + (block * 0x9e3779b97f4a7c15ull >> 40)) % paths), true};
+            return {static_cast<int>((run + mix(run / paths)) % paths), true};
         }
         const int fast = fastest(prior);
-        const std::uint64_t h = run * 0x9e3779b97f4a7c15ull;
-        if ((h >> 40) % (clear(fast) ? kSampleFar : kSample) != 0) return {fast, false};
-        return {static_cast<int>((h >> 20) % paths), true};
+        const std::uint64_t h = mix(run);
+        if (h % kSample != 0) return {fast, false};
+        int path = static_cast<int>((h >> 16) % paths);
+        if (path != fast && far(path, fast) && (h >> 32) % (kSampleFar / kSample) != 0) path = fast;
+        return {path, true};
     }
     // The path of least time per ray among those with counted batches; the prior while none has.
     int fastest(int prior) const {
@@ -98,13 +102,8 @@ public:
             if (cost(p) > 0.0 && (fast < 0 || cost(p) < cost(fast))) fast = p;
         return fast < 0 ? prior : fast;
     }
-    // Whether every other path costs more than kFar times `fast` (a path with nothing counted does not).
-    bool clear(int fast) const {
-        if (!(cost(fast) > 0.0)) return false;
-        for (int p = 0; p < paths_; ++p)
-            if (p != fast && !(cost(p) > kFar * cost(fast))) return false;
-        return true;
-    }
+    // Whether `path` costs more than kFar times `fast` (a path with nothing counted does not).
+    bool far(int path, int fast) const { return cost(fast) > 0.0 && cost(path) > kFar * cost(fast); }
     // A warm batch of a timed run: its path, its thread's CPU time and its rays.
     void record(int path, double seconds, std::size_t rays) {
         add(seconds_[path], seconds);
@@ -113,6 +112,13 @@ public:
     }
 
 private:
+    // SplitMix64's finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators",
+    // OOPSLA 2014): independent-looking bits for consecutive run numbers.
+    static std::uint64_t mix(std::uint64_t x) {
+        x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+        x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+        return x ^ (x >> 31);
+    }
     static void add(std::atomic<double>& sum, double x) {
         for (double old = sum.load(std::memory_order_relaxed);
              !sum.compare_exchange_weak(old, old + x, std::memory_order_relaxed);) {
