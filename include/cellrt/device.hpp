@@ -58,8 +58,31 @@ private:
     std::uint8_t* occluded_ = nullptr;
 };
 
+// What memory mode (b)'s software caches in shared memory counted (docs/GPU.md), as the local-store
+// model's CacheStats counts: a read looks up every line its object overlaps. A lookup that finds the
+// line is a hit, one that does not is a miss (it fills the line, or reads global memory when another
+// thread of the block is filling the slot: `unfilled`); a hit whose line another thread replaced
+// while it was being copied out reads global memory instead (`torn`). Only the GPU's concurrent
+// threads make the last two: on the host they stay 0.
+struct DeviceCacheCounts {
+    unsigned long long hits = 0, misses = 0, evictions = 0, torn = 0, unfilled = 0;
+
+    unsigned long long lookups() const { return hits + misses + torn; }
+    DeviceCacheCounts& operator+=(const DeviceCacheCounts& o) {
+        hits += o.hits; misses += o.misses; evictions += o.evictions; torn += o.torn; unfilled += o.unfilled;
+        return *this;
+    }
+};
+
+// The counts of every block of every launch so far, summed; all zero in memory mode (a).
+struct DeviceCacheStats {
+    DeviceCacheCounts node_cache, triangle_cache;  // nodes and leaf entries; triangles
+    unsigned long long blocks = 0;                 // blocks launched with the caches
+};
+
 class DeviceAccelerator : public Accelerator {
 public:
+    virtual DeviceCacheStats cache_stats() const = 0;
     // Trace a resident batch in place; return the kernel's own time in seconds (CUDA events: no
     // transfer, no launch set-up on the host). Counters as for intersect().
     virtual double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
