@@ -11,8 +11,16 @@ namespace {
 
 constexpr const char* kCaches[] = {"node", "triangle"};
 
+// LINExSETS, or LINExSETSxWAYS when 4-way: as the local store's CacheLayout::to_string writes it.
 std::string layout_text(const SharedCacheLayout& l) {
-    return std::to_string(l.line_bytes) + "x" + std::to_string(l.sets) + (l.ways == 1 ? "" : "x" + std::to_string(l.ways));
+    std::string s = std::to_string(l.line_bytes);
+    s += 'x';
+    s += std::to_string(l.sets);
+    if (l.ways != 1) {
+        s += 'x';
+        s += std::to_string(l.ways);
+    }
+    return s;
 }
 
 bool is_memory_param(const std::string& name) {

@@ -277,7 +277,7 @@ public:
 private:
     static_assert(sizeof(Node) % 4 == 0 && sizeof(Triangle) % 4 == 0, "the caches copy whole 32-bit words");
     SharedCache node_cache_, triangle_cache_;
-    const CacheAddressMap& map_;
+    CacheAddressMap map_;
     Node node_;
     Triangle triangle_;
 };
