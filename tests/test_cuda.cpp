@@ -96,21 +96,19 @@ TEST(CudaRefusals, InTheLibrarysWords) {
 // line on any machine with the CUDA backend built.
 TEST(CudaRefusals, SharedMemoryLayouts) {
     const std::vector<Triangle> tri = {{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}}};
-    AccelConfig c = cuda_config("kd");
-    c.params = {{"memory", "shared"}, {"node_line", "48"}};
-    const std::string e = test::error_of([&] { make_accelerator(tri, c); });
+    auto expect_refused = [&](std::map<std::string, std::string> params, const std::string& why) {
+        AccelConfig c = cuda_config("kd");
+        c.params = std::move(params);
+        const std::string e = test::error_of([&] { make_accelerator(tri, c); });
 #ifdef CELLRT_HAVE_CUDA
-    EXPECT_EQ(e, "cuda parameter node_line=48: a line is a power of two bytes");
+        EXPECT_EQ(e, why);
 #else
-    EXPECT_EQ(e, "device 'cuda': " + cuda_device_info().reason);
+        EXPECT_EQ(e, "device 'cuda': " + cuda_device_info().reason) << why;
 #endif
-    c.params = {{"triangle_ways", "4"}};
-    const std::string global = test::error_of([&] { make_accelerator(tri, c); });
-#ifdef CELLRT_HAVE_CUDA
-    EXPECT_EQ(global, "cuda parameter triangle_ways=4 shapes the shared-memory caches: it needs memory=shared");
-#else
-    EXPECT_EQ(global, "device 'cuda': " + cuda_device_info().reason);
-#endif
+    };
+    expect_refused({{"memory", "shared"}, {"node_line", "48"}}, "cuda parameter node_line=48: a line is a power of two bytes");
+    expect_refused({{"triangle_ways", "4"}},
+                   "cuda parameter triangle_ways=4 shapes the shared-memory caches: it needs memory=shared");
 }
 
 class CudaAgainstBruteForce : public testing::TestWithParam<std::tuple<std::string, std::string>> {};
