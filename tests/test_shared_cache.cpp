@@ -126,6 +126,41 @@ TEST(SharedCache, FourWayLruByHand) {
     EXPECT_EQ(n.lookups() - before.lookups(), 2u);
 }
 
+// The seqlock's fall-back, as another thread of a block would trigger it: a line whose sequence
+// number is odd (being filled) is neither read nor claimed, and the read takes its bytes from global
+// memory, counted unfilled; once the number is even again the line is the cache's.
+TEST(SharedCache, ALineBeingFilledIsReadFromGlobalMemory) {
+    std::vector<std::uint32_t> bytes(64);
+    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = 1000 + static_cast<std::uint32_t>(i);
+    CacheAddressMap map{};
+    map.data[0] = map.data[1] = map.data[2] = reinterpret_cast<const std::byte*>(bytes.data());
+    for (int r = 0; r < 3; ++r) {
+        map.base[r] = r == 0 ? 4096 : 1u << 30;
+        map.bytes[r] = r == 0 ? bytes.size() * 4 : 0;
+    }
+    const SharedCacheLayout layout{16, 4, 1};
+    HostCache c(layout);
+    // The directory follows the lines: tags, then sequence numbers (shared_cache.hpp).
+    std::uint32_t& seq0 = c.words[layout.lines() * layout.line_bytes / 4 + layout.lines()];
+    DeviceCacheCounts n;
+    std::uint32_t out[3];
+    c.cache.read(map, 4096 + 4, 12, out, n);  // line 0, slot 0: a miss that fills it
+    EXPECT_EQ(seq0, 2u);
+    seq0 = 3;  // another thread is filling slot 0
+    out[0] = out[1] = out[2] = 0;
+    c.cache.read(map, 4096 + 4, 12, out, n);
+    EXPECT_EQ(n.misses, 2u);
+    EXPECT_EQ(n.unfilled, 1u);
+    EXPECT_EQ(n.hits, 0u);
+    EXPECT_EQ(out[0], 1001u);
+    EXPECT_EQ(out[2], 1003u);
+    seq0 = 4;  // it is done, with line 0 still there
+    c.cache.read(map, 4096 + 4, 12, out, n);
+    EXPECT_EQ(n.hits, 1u);
+    EXPECT_EQ(n.lookups(), 3u);
+    EXPECT_EQ(n.torn, 0u);
+}
+
 // Whole traversals: one worker of the model (synchronous access) and the policy of mode (b) on the
 // host, tracing the same rays in the same order over the same tree, count the same hits, misses and
 // evictions in the node cache (nodes and leaf entries) and in the triangle cache, for every tree and

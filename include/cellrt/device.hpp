@@ -60,10 +60,10 @@ private:
 
 // What memory mode (b)'s software caches in shared memory counted (docs/GPU.md), as the local-store
 // model's CacheStats counts: a read looks up every line its object overlaps. A lookup that finds the
-// line is a hit, one that does not is a miss (it fills the line, or reads global memory when another
-// thread of the block is filling the slot: `unfilled`); a hit whose line another thread replaced
-// while it was being copied out reads global memory instead (`torn`). Only the GPU's concurrent
-// threads make the last two: on the host they stay 0.
+// line is a hit, one that does not a miss (it fills the line, or, of those, `unfilled` ones read
+// global memory because another thread of the block was filling the slot); a lookup that finds the
+// line but sees it replaced while copying it out reads global memory too and counts as `torn`, not
+// as a hit. Only concurrent threads make the last two: one thread a cache (the host's tests) never.
 struct DeviceCacheCounts {
     unsigned long long hits = 0, misses = 0, evictions = 0, torn = 0, unfilled = 0;
 
@@ -82,11 +82,12 @@ struct DeviceCacheStats {
 
 class DeviceAccelerator : public Accelerator {
 public:
-    virtual DeviceCacheStats cache_stats() const = 0;
     // Trace a resident batch in place; return the kernel's own time in seconds (CUDA events: no
     // transfer, no launch set-up on the host). Counters as for intersect().
     virtual double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
     virtual double occluded_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
+    // Memory mode (b)'s cache counts over every call so far, host and resident batches alike.
+    virtual DeviceCacheStats cache_stats() const = 0;
 };
 
 }  // namespace cellrt
