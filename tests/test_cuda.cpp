@@ -9,8 +9,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 #include "accel/local_store_registry.hpp"
 #include "cellrt/accel.hpp"
@@ -109,6 +112,71 @@ TEST(CudaRefusals, SharedMemoryLayouts) {
     expect_refused({{"memory", "shared"}, {"node_line", "48"}}, "cuda parameter node_line=48: a line is a power of two bytes");
     expect_refused({{"triangle_ways", "4"}},
                    "cuda parameter triangle_ways=4 shapes the shared-memory caches: it needs memory=shared");
+}
+
+// `cache-study --device cuda` checks its options before it looks for the device, and without one it
+// fails in one line and writes nothing.
+TEST(CudaRefusals, CacheStudyOnTheDevice) {
+    const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
+    const std::string study = "cache-study builtin:spheres?tris=200 --size 16x16 -o " + dir.string() + " --device ";
+    const auto [async, async_status] = run_cli(study + "cuda --access async");
+    EXPECT_EQ(async_status, 1) << async;
+    EXPECT_EQ(async, "cellrt: error: --access async: the GPU's shared-memory caches read synchronously (docs/GPU.md)\n");
+    const auto [other, other_status] = run_cli(study + "tpu");
+    EXPECT_EQ(other_status, 1) << other;
+    EXPECT_EQ(other, "cellrt: error: --device 'tpu' is not one of: cpu, cuda\n");
+    if (!have_gpu()) {
+        const auto [out, status] = run_cli(study + "cuda");
+        EXPECT_EQ(status, 1) << out;
+        EXPECT_EQ(out, "cellrt: error: --device cuda: no device (" + cuda_device_info().reason + ")\n");
+    }
+    EXPECT_FALSE(fs::exists(dir));
+}
+
+// The study's sweeps on the GPU: one CSV row per run, as the model writes, each run's lookups those of
+// the model's run with the same layouts (a read's lookups depend on its address and size only), its
+// time measured (frame_ms) and none modelled (cycles 0).
+TEST(CudaCacheStudy, SameRunsAndLookupsAsTheModel) {
+    REQUIRE_GPU();
+    const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
+    const std::string study = "cache-study builtin:spheres?tris=2000 --size 64x64 --sample 1 --structures kd bih "
+                              "--traversals branched --access sync --overwrite -o ";
+    for (const char* device : {"cpu", "cuda"}) {
+        const auto [out, status] = run_cli(study + (dir / device).string() + " --device " + device);
+        ASSERT_EQ(status, 0) << out;
+    }
+    auto rows = [&](const char* device) {
+        std::ifstream in(dir / device / "cache_study.csv");
+        std::vector<std::vector<std::string>> out;
+        for (std::string line; std::getline(in, line);) {
+            std::vector<std::string> cells;
+            std::stringstream fields(line);
+            for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(cell);
+            out.push_back(cells);
+        }
+        return out;
+    };
+    const auto cpu = rows("cpu"), gpu = rows("cuda");
+    ASSERT_EQ(gpu.size(), cpu.size());
+    ASSERT_GT(gpu.size(), 1u);
+    EXPECT_EQ(gpu[0], cpu[0]);  // the header
+    const auto& h = cpu[0];
+    auto at = [&](const std::vector<std::string>& row, const std::string& column) {
+        return row[static_cast<std::size_t>(std::find(h.begin(), h.end(), column) - h.begin())];
+    };
+    for (std::size_t i = 1; i < gpu.size(); ++i) {
+        for (const char* same : {"structure", "sweep", "node_layout", "tri_layout", "rays"})
+            EXPECT_EQ(at(gpu[i], same), at(cpu[i], same)) << "row " << i << " " << same;
+        for (const char* cache : {"node", "tri"}) {
+            const std::string c(cache);
+            EXPECT_EQ(std::stoull(at(gpu[i], c + "_hits")) + std::stoull(at(gpu[i], c + "_misses")),
+                      std::stoull(at(cpu[i], c + "_hits")) + std::stoull(at(cpu[i], c + "_misses")))
+                << "row " << i << " " << c << " lookups";
+        }
+        EXPECT_EQ(at(gpu[i], "cycles"), "0");
+        EXPECT_GT(std::stod(at(gpu[i], "frame_ms")), 0.0) << "row " << i;
+    }
+    fs::remove_all(dir);
 }
 
 class CudaAgainstBruteForce : public testing::TestWithParam<std::tuple<std::string, std::string>> {};
