@@ -11,6 +11,14 @@
 // a sample of the packets: those whose column + row is a multiple of --sample. Each run is one worker
 // tracing the sample in order, so its figures are reproducible; runs are spread over --threads
 // threads.
+//
+// With --device cuda the same runs go to the GPU's memory mode (b) instead (docs/GPU.md): the study's
+// caches in each block's shared memory, of the run's layouts, synchronous access only. The frame's
+// sampled rays are copied to the device once, each run's tree is built and copied there, and its
+// primary and shadow rays are traced as two resident batches, one ray per thread. The CSV keeps its
+// columns: hits and misses are the blocks' lookups summed (a torn read counts as a miss), bytes the
+// lines filled, the cycle columns 0 (nothing is modelled) and frame_ms the kernels' own time (CUDA
+// events) per ray times the frame's rays; best_layouts.md ranks by that time.
 #include <algorithm>
 #include <cstring>
 #include <atomic>
@@ -26,6 +34,8 @@
 #include <utility>
 
 #include "accel/local_store_registry.hpp"
+#include "cellrt/accel.hpp"
+#include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
 #include "cellrt/render.hpp"
@@ -80,6 +90,7 @@ struct Run {
 struct Result {
     LocalStoreStats stats;
     double wall_seconds = 0.0;
+    double kernel_seconds = 0.0;  // --device cuda: the kernels' own time; 0 on the model
 };
 
 Result trace(const LocalStoreAccelerator& base, const Run& run, const FrameRays& w) {
@@ -94,6 +105,67 @@ Result trace(const LocalStoreAccelerator& base, const Run& run, const FrameRays&
         accel->occluded(std::span(w.secondary).subspan(p.secondary, p.secondary_count), occluded);
     }
     return {accel->local_store_stats(), timer.seconds()};
+}
+
+// The frame's sampled rays on the device: its primary rays, then its shadow rays, each one batch.
+struct DeviceFrame {
+    DeviceRayBatch primary, shadow;
+    explicit DeviceFrame(const FrameRays& w)
+        : primary(std::max<std::size_t>(w.primary.size(), 1)), shadow(std::max<std::size_t>(w.secondary.size(), 1)) {
+        primary.upload(w.primary);
+        shadow.upload(w.secondary);
+    }
+};
+
+// The device's counts as the model's: a torn read went to global memory, so it is a miss; the bytes
+// moved are the lines filled (a miss that found its slot being filled read global memory alone).
+CacheStats model_counts(const DeviceCacheCounts& d, std::uint32_t line_bytes) {
+    CacheStats c;
+    c.hits = d.hits;
+    c.misses = d.misses + d.torn;
+    c.evictions = d.evictions;
+    c.bytes = (d.misses - d.unfilled) * std::uint64_t{line_bytes};
+    return c;
+}
+
+// One run on the GPU, memory mode (b) with the run's layouts (synchronous: `access` is sync).
+Result trace_device(const Scene& scene, const Run& run, const FrameRays& w, DeviceFrame& frame) {
+    AccelConfig c;
+    c.kind = run.structure;
+    c.traversal = run.traversal;
+    c.device = "cuda";
+    const CacheLayout &n = run.config.node_cache, &t = run.config.triangle_cache;
+    c.params = {{"memory", "shared"},
+                {"node_line", std::to_string(n.line_bytes)},
+                {"node_sets", std::to_string(n.sets)},
+                {"node_ways", std::to_string(n.ways)},
+                {"triangle_line", std::to_string(t.line_bytes)},
+                {"triangle_sets", std::to_string(t.sets)},
+                {"triangle_ways", std::to_string(t.ways)}};
+    const auto accel = make_device_accelerator(scene.triangles, c);
+    Result r;
+    Timer timer;
+    if (!w.primary.empty()) r.kernel_seconds += accel->intersect_resident(frame.primary);
+    if (!w.secondary.empty()) r.kernel_seconds += accel->occluded_resident(frame.shadow);
+    r.wall_seconds = timer.seconds();
+    const DeviceCacheStats d = accel->cache_stats();
+    r.stats.node_cache = model_counts(d.node_cache, n.line_bytes);
+    r.stats.triangle_cache = model_counts(d.triangle_cache, t.line_bytes);
+    r.stats.rays = w.primary.size() + w.secondary.size();
+    return r;
+}
+
+// Every run on the GPU, one after another; results in the order of `runs`.
+std::vector<Result> trace_all_device(const Scene& scene, const std::vector<Run>& runs, const FrameRays& w) {
+    DeviceFrame frame(w);
+    std::vector<Result> results;
+    Progress progress;
+    for (const Run& run : runs) {
+        if (g_cancel) throw Error("cache study cancelled");
+        results.push_back(trace_device(scene, run, w, frame));
+        progress(results.size(), runs.size());
+    }
+    return results;
 }
 
 // Runs every run on `threads` threads, each run on one thread; results in the order of `runs`.
@@ -162,7 +234,9 @@ std::string csv_row(const std::string& scene, const Run& run, const Result& r, s
     const LocalStoreConfig& c = run.config;
     const LocalStoreStats& s = r.stats;
     const CacheStats &n = s.node_cache, &t = s.triangle_cache;
-    const double frame_ms = s.cycles_per_ray() * static_cast<double>(frame_rays) / (c.cost.clock_ghz * 1e6);
+    const double frame_ms = r.kernel_seconds > 0.0
+                                ? 1e3 * r.kernel_seconds / static_cast<double>(s.rays) * static_cast<double>(frame_rays)
+                                : s.cycles_per_ray() * static_cast<double>(frame_rays) / (c.cost.clock_ghz * 1e6);
     char buf[1024];
     std::snprintf(buf, sizeof buf,
                   "%s,%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%.6f,%llu,%llu,%llu,%llu,%llu,%.6f,%llu,%llu,"
@@ -187,7 +261,14 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
     const Run& first = runs[group.front()];
     const bool node = first.sweep == "node";
     auto layout = [&](std::size_t i) { return node ? runs[i].config.node_cache : runs[i].config.triangle_cache; };
-    auto cycles = [&](std::size_t i) { return results[i].stats.cycles; };
+    // The model's cycles, or on the device the kernels' time.
+    auto cycles = [&](std::size_t i) {
+        return results[i].kernel_seconds > 0.0 ? results[i].kernel_seconds : static_cast<double>(results[i].stats.cycles);
+    };
+    auto per_ray = [&](std::size_t i) {
+        const Result& r = results[i];
+        return r.kernel_seconds > 0.0 ? 1e9 * r.kernel_seconds / static_cast<double>(r.stats.rays) : r.stats.cycles_per_ray();
+    };
     const CacheLayout study = node ? study_node_layout(first.structure) : kStudyTriangleLayout;
     std::size_t best = group.front(), best_direct = group.front(), at_study = group.front();
     for (std::size_t i : group) {
@@ -198,15 +279,16 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
     auto cell = [&](std::size_t i) {
         const LocalStoreStats& s = results[i].stats;
         char buf[96];
-        std::snprintf(buf, sizeof buf, "%s: %.1f %%, %.0f", layout(i).to_string().c_str(),
-                      100.0 * (node ? s.node_cache : s.triangle_cache).hit_ratio(), s.cycles_per_ray());
+        std::snprintf(buf, sizeof buf, results[i].kernel_seconds > 0.0 ? "%s: %.1f %%, %.2f" : "%s: %.1f %%, %.0f",
+                      layout(i).to_string().c_str(), 100.0 * (node ? s.node_cache : s.triangle_cache).hit_ratio(),
+                      per_ray(i));
         return std::string(buf);
     };
     char buf[512];
     std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.2f |\n", scene.c_str(),
                   first.structure.c_str(), first.traversal.c_str(), to_string(first.config.access),
                   node ? "nodes" : "triangles", cell(best).c_str(), cell(best_direct).c_str(), cell(at_study).c_str(),
-                  static_cast<double>(cycles(at_study)) / static_cast<double>(cycles(best)));
+                  cycles(at_study) / cycles(best));
     return buf;
 }
 
@@ -227,7 +309,7 @@ std::vector<std::string> checked_choices(const std::string& option, const std::v
 Runner add_cache_study(CLI::App& app) {
     struct Options {
         std::vector<std::string> scenes;
-        std::string out = "cache-study", size;
+        std::string out = "cache-study", size, device = "cpu";
         int packet = RenderOptions{}.packet, sample = 8;
         unsigned threads = 0;
         bool overwrite = false;
@@ -236,7 +318,8 @@ Runner add_cache_study(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     auto* cmd = app.add_subcommand("cache-study", "The study's cache experiments (Graphs 5-1 to 5-10) through the "
-                                                  "local-store model: CSV for bench/plot_cache_study.py");
+                                                  "local-store model, or the GPU's shared-memory caches: CSV for "
+                                                  "bench/plot_cache_study.py");
     cmd->add_option("scenes", o->scenes, scene_help() + "; one or more")->required();
     cmd->add_option("-o,--out", o->out, "Output folder (cache_study.csv, best_layouts.md)")->capture_default_str();
     cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default: each view file's)");
@@ -247,12 +330,16 @@ Runner add_cache_study(CLI::App& app) {
     cmd->add_option("--threads", o->threads, "Runs traced at once (0: all cores)")->capture_default_str();
     cmd->add_option("--structures", o->structures, "Structures: kd, bih")->capture_default_str();
     cmd->add_option("--traversals", o->traversals, "Traversals: branched, branchless")->capture_default_str();
-    cmd->add_option("--access", o->access, "Cache access modes: sync, async")->capture_default_str();
+    auto* access = cmd->add_option("--access", o->access, "Cache access modes: sync, async")->capture_default_str();
+    cmd->add_option("--device", o->device,
+                    "cpu: the local-store model (modelled cycles); cuda: the GPU's software caches in shared "
+                    "memory (memory mode (b), measured kernel time; sync access only)")
+        ->capture_default_str();
     cmd->add_option("--sweeps", o->sweeps, "Caches swept: node (Graphs 5-1..5-6), triangle (5-7..5-10)")
         ->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace existing output files");
     cluster::add_sweep_options(*cmd);
-    return [o] {
+    return [o, access] {
         // Under MPI each step runs on every rank, a step that fails on one fails on all, and the runs
         // are shared among the ranks (cluster.hpp); rank 0 alone prints and writes.
         std::string csv_path, md_path;
@@ -260,6 +347,18 @@ Runner add_cache_study(CLI::App& app) {
             checked_choices("--structures", o->structures, {"kd", "bih"});
             checked_choices("--traversals", o->traversals, {"branched", "branchless"});
             checked_choices("--access", o->access, {"sync", "async"});
+            checked_choices("--device", {o->device}, {"cpu", "cuda"});
+            if (o->device == "cuda") {
+                // Mode (b) reads synchronously (no cp.async touch yet): the default list shrinks to it,
+                // an explicit async is refused.
+                if (access->count() == 0) o->access = {"sync"};
+                else if (std::find(o->access.begin(), o->access.end(), "async") != o->access.end())
+                    throw Error("--access async: the GPU's shared-memory caches read synchronously (docs/GPU.md)");
+                if (cluster::ranks() > 1)
+                    throw Error("--device cuda runs in one process (one GPU); run it without mpirun");
+                const DeviceInfo gpu = cuda_device_info();
+                if (!gpu.present) throw Error("--device cuda: no device (" + gpu.reason + ")");
+            }
             checked_choices("--sweeps", o->sweeps, {"node", "triangle"});
             if (o->sample < 1 || o->sample > 1024)
                 throw Error("--sample " + std::to_string(o->sample) + " must lie in [1, 1024]");
@@ -280,8 +379,10 @@ Runner add_cache_study(CLI::App& app) {
         const unsigned threads = o->threads ? o->threads : cluster::cores();
 
         std::string csv = csv_header();
-        std::string md = "| scene | structure | traversal | access | cache | best layout: hit ratio, cycles/ray | best "
-                         "direct-mapped | the study's layout | study / best |\n|---|---|---|---|---|---|---|---|---|\n";
+        const bool gpu = o->device == "cuda";
+        std::string md = std::string("| scene | structure | traversal | access | cache | best layout: hit ratio, ") +
+                         (gpu ? "kernel ns/ray" : "cycles/ray") +
+                         " | best direct-mapped | the study's layout | study / best |\n|---|---|---|---|---|---|---|---|---|\n";
         Timer total;
         for (const std::string& spec : o->scenes) {
             const Scene scene = cluster::load_scene(spec);
@@ -303,7 +404,7 @@ Runner add_cache_study(CLI::App& app) {
                     AccelConfig ac;
                     ac.kind = structure;
                     ac.threads = o->threads;
-                    bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
+                    if (!gpu) bases[structure] = make_local_store_accelerator(scene.triangles, ac, LocalStoreConfig{});
                     for (const std::string& sweep : o->sweeps)
                         for (const std::string& traversal : o->traversals)
                             for (const std::string& access : o->access)
@@ -318,9 +419,11 @@ Runner add_cache_study(CLI::App& app) {
                 }
             }, "building the structures");
             Timer timer;
-            const std::vector<Result> results = trace_shared(bases, runs, w, threads);
+            const std::vector<Result> results = gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
             if (!cluster::leader()) continue;
-            if (cluster::ranks() == 1)
+            if (gpu)
+                std::printf("  %zu runs in %.1f s on %s\n", runs.size(), timer.seconds(), cuda_device_info().name.c_str());
+            else if (cluster::ranks() == 1)
                 std::printf("  %zu runs in %.1f s on %u threads\n", runs.size(), timer.seconds(), threads);
             else
                 std::printf("  %zu runs in %.1f s on %d ranks of %u threads\n", runs.size(), timer.seconds(),

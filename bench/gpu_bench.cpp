@@ -30,8 +30,10 @@ struct Options {
     std::string scenes_dir = "../shared/scenes";
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "builtin:city"};
     std::vector<std::string> rays{"frame", "ao", "diffuse"};
+    // The last two: memory mode (b), the study's caches in shared memory (its default layouts).
     std::vector<std::string> configs{"kd:branched", "kd:branchless", "kd:rec", "bih:branched", "bih:branchless",
-                                     "bih:branched@split=sah"};
+                                     "bih:branched@split=sah", "kd:branched@memory=shared",
+                                     "bih:branched@memory=shared"};
     std::string cpu_config = "embree";
     std::string size = "1920x1080", json_path;
     int repeats = 5, ao_samples = 4;
@@ -144,6 +146,20 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
                          {"with_copies_grays_per_s", s.rays.size() / median(copies) * 1e-9},
                          {"differing", differing(a, s.exact) + differing(resident, s.exact)}};
             if (row.contains("cpu")) r[s.name]["times_cpu"] = row["cpu"][s.name]["seconds"].get<double>() / median(kernel);
+        }
+        if (const DeviceCacheStats cs = gpu_accel->cache_stats(); cs.blocks > 0) {
+            auto counts = [](const DeviceCacheCounts& c) {
+                return nlohmann::json{{"hits", c.hits},           {"misses", c.misses}, {"evictions", c.evictions},
+                                      {"torn", c.torn},           {"unfilled", c.unfilled},
+                                      {"hit_ratio", c.lookups() ? double(c.hits) / double(c.lookups()) : 0.0}};
+            };
+            // Over every launch of this configuration on this scene, all ray sets together.
+            const auto settings = gpu_accel->stats().settings;
+            const auto memory = std::find_if(settings.begin(), settings.end(), [](const auto& kv) { return kv.first == "memory"; });
+            r["shared_caches"] = {{"layout", memory != settings.end() ? memory->second : ""},
+                                  {"blocks", cs.blocks},
+                                  {"node_cache", counts(cs.node_cache)},
+                                  {"triangle_cache", counts(cs.triangle_cache)}};
         }
         std::printf("| %s | %.3f | %.3f | %.3f / %.3f | %zu |\n", spec.c_str(), r["primary"]["grays_per_s"].get<double>(),
                     r[sets[1].name]["grays_per_s"].get<double>(), r["primary"]["with_copies_grays_per_s"].get<double>(),

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <random>
 
@@ -104,6 +105,32 @@ TEST(Bih, SameHierarchyBytesAtAnyThreadCount) {
                         << what;
                     EXPECT_EQ(one.prims, many.prims) << what;
                 }
+        }
+    }
+}
+
+// The root's bounds, taken per block of triangles on several threads and combined in block order, are
+// one pass's to the bit: where +0 and -0 both bound the scene, the first met is kept (std::min), as
+// the tree's clip planes are. Blocks are 16,384 triangles; the two zeros lie in different blocks.
+TEST(Bih, RootBoundsKeepTheFirstOfEqualZerosAtAnyThreadCount) {
+    for (const bool plus_first : {true, false}) {
+        std::vector<Triangle> tris;
+        for (int i = 0; i < 40000; ++i) {
+            const float x = 1.f + static_cast<float>(i % 200), y = static_cast<float>(i / 200);
+            tris.push_back({{x, y, 1.f}, {x + 1.f, y, 1.f}, {x, y + 1.f, 2.f}});
+        }
+        const float first = plus_first ? 0.f : -0.f, second = plus_first ? -0.f : 0.f;
+        tris[10].v0.x = first;
+        tris[30000].v1.x = second;
+        Box3 expected;
+        for (const Triangle& t : tris) expected.extend(t.bounds());
+        ASSERT_EQ(std::signbit(expected.lo.x), !plus_first);
+        for (unsigned threads : {1u, 2u, 4u}) {
+            detail::BihBuildParams p;
+            p.split = detail::BihSplit::sah;
+            p.threads = threads;
+            const detail::BihTree tree = detail::build_bih(tris, p);
+            EXPECT_EQ(std::memcmp(&tree.bounds, &expected, sizeof expected), 0) << threads << " threads";
         }
     }
 }

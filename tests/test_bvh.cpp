@@ -248,102 +248,124 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
     EXPECT_EQ(detail::batch_coherence({}), 1.f);
 }
 
-// The measured route: the prior until a sample is in, then the path with the smaller time over the
-// samples; every batch sampled while it learns, few once it knows, fewer when the choice is clear.
-// How many of the next n batches (coherent by the prior) the picker samples.
-int sampled(detail::RoutePicker& p, int n) {
-    int s = 0;
-    for (int i = 0; i < n; ++i) s += p.pick(0).sampled ? 1 : 0;
-    return s;
-}
+// The measured route. The first kPrior batches go by coherence, untimed; then, while it learns, runs
+// of kRun batches go to the paths in turn, all timed; then the path of least time per ray takes the
+// runs that are not timed, and a timed run goes to any path (the fastest too), fewer of them once the
+// choice is clear. `take(p, n, prior)` picks n batches and returns how many were timed, recording for
+// each timed one `per_ray[path]` seconds on a batch of `rays` rays.
+struct PickerRun {
+    detail::RoutePicker& picker;
+    std::vector<double> per_ray;
+    int paths_seen[3] = {};
+    int take(int n, int prior = 0, std::size_t rays = 100) {
+        int timed = 0;
+        for (int i = 0; i < n; ++i) {
+            const detail::RoutePicker::Choice c = picker.pick(prior);
+            ++paths_seen[c.path];
+            if (!c.timed) continue;
+            ++timed;
+            picker.record(c.path, per_ray[static_cast<std::size_t>(c.path)] * static_cast<double>(rays), rays);
+        }
+        return timed;
+    }
+};
 
-TEST(Routed, PickerTakesThePathThatTookLessTime) {
+TEST(Routed, PickerLearnsInRunsThenTakesThePathOfLeastTimePerRay) {
     using detail::RoutePicker;
     RoutePicker picker;
-    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) {  // coherence alone, nothing traced twice
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) {  // coherence alone, nothing timed
         const RoutePicker::Choice c = picker.pick(static_cast<int>(i % 2));
         EXPECT_EQ(c.path, static_cast<int>(i % 2));
-        EXPECT_FALSE(c.sampled);
+        EXPECT_FALSE(c.timed);
     }
-    const RoutePicker::Choice warm = picker.pick(1);
-    EXPECT_EQ(warm.path, 1);
-    EXPECT_TRUE(warm.sampled);
-    EXPECT_FALSE(warm.counts);
-    EXPECT_EQ(picker.pick(0).path, 0);  // nothing recorded yet: the prior
-    for (int i = 0; i < 16; ++i) picker.record(2.0, 1.0);
-    for (int i = 0; i < 8; ++i) {
-        EXPECT_EQ(picker.pick(0).path, 1);
-        EXPECT_EQ(picker.pick(1).path, 1);
+    // Learning: runs of kRun consecutive batches, every batch timed; each block of two runs gives one
+    // to each path, in an order that varies from block to block.
+    std::vector<int> run_paths;
+    for (std::uint64_t run = 0; run < 2 * RoutePicker::kLearnRuns; ++run)
+        for (std::uint64_t i = 0; i < RoutePicker::kRun; ++i) {
+            const RoutePicker::Choice c = picker.pick(1);
+            if (i == 0) run_paths.push_back(c.path);
+            EXPECT_EQ(c.path, run_paths.back());
+            EXPECT_TRUE(c.timed);
+            // Batches of different sizes: per ray the packets take 3 units, the BVH 2.
+            const std::size_t rays = 32 + 7 * i;
+            picker.record(c.path, (c.path == 0 ? 3.0 : 2.0) * static_cast<double>(rays), rays);
+        }
+    int blocks_led_by[2] = {};
+    for (std::size_t b = 0; b + 1 < run_paths.size(); b += 2) {
+        EXPECT_NE(run_paths[b], run_paths[b + 1]);
+        ++blocks_led_by[run_paths[b]];
     }
-    // A preempted batch counts at most kClamp times the other path's time: 34 against 16 + 8 * 2 = 32,
-    // still the BVH (unclamped, 34 against 56).
-    picker.record(2.0, 40.0);
-    EXPECT_EQ(picker.pick(0).path, 1);
-    for (int i = 0; i < 20; ++i) picker.record(1.0, 3.0);
-    EXPECT_EQ(picker.pick(1).path, 0);
+    EXPECT_GT(blocks_led_by[0], 0);
+    EXPECT_GT(blocks_led_by[1], 0);
+    EXPECT_DOUBLE_EQ(picker.cost(0), 3.0);
+    EXPECT_DOUBLE_EQ(picker.cost(1), 2.0);
+    EXPECT_EQ(picker.samples(0), RoutePicker::kLearnRuns * RoutePicker::kRun);
+    // Known: the BVH, whatever the prior, except in the runs timed on the packets.
+    PickerRun run{picker, {3.0, 2.0}};
+    const int n = 8000;
+    const int timed = run.take(n, 0);
+    EXPECT_GT(run.paths_seen[1], n * 9 / 10);
+    EXPECT_GT(run.paths_seen[0], 0);  // timed runs reach the slower path too
+    EXPECT_LE(run.paths_seen[0], timed);
+    // The workload changes: the BVH's rays get dearer, and its timed runs tell.
+    run.per_ray = {3.0, 9.0};
+    run.take(40000, 1);
+    EXPECT_GT(picker.cost(1), picker.cost(0));
+    EXPECT_EQ(picker.fastest(1), 0);
 }
 
-// With the streams, three paths: the packets and one partner per sample, the partners by turns (the
-// single rays and the streams are never timed one after the other on the same rays); each partner's
-// cost is its time over the packets' on its own samples, and the route takes the cheapest, sampling
-// rarely only when both others are clearly dearer.
+// With the streams, three paths, learned in turn; the cheapest per ray is taken.
 TEST(Routed, PickerChoosesAmongThreePaths) {
     using detail::RoutePicker;
     RoutePicker picker(3);
     EXPECT_EQ(picker.paths(), 3);
-    for (std::uint64_t i = 0; i <= RoutePicker::kPrior; ++i) EXPECT_EQ(picker.pick(1).path, 1);  // the prior
-    int partners[3] = {};
-    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
-        const RoutePicker::Choice c = picker.pick(1);
-        ++partners[c.partner];
-        // Batches of different sizes: the packets take 3 units, the single rays 2, the streams 1.
-        const double size = 1.0 + static_cast<double>(i % 5);
-        picker.record(c.partner, 3.0 * size, (c.partner == 1 ? 2.0 : 1.0) * size);
-    }
-    EXPECT_EQ(partners[1], partners[2]);  // by turns
-    EXPECT_NEAR(picker.cost(1), 2.0 / 3.0, 1e-9);
-    EXPECT_NEAR(picker.cost(2), 1.0 / 3.0, 1e-9);
-    EXPECT_EQ(picker.pick(0).path, 2);
-    EXPECT_EQ(picker.pick(1).path, 2);
-    // A preempted batch counts at most kClamp times the packets' time.
-    const double streams = picker.seconds(2), packets = picker.packet_seconds(2);
-    picker.record(2, 1.0, 1000.0);
-    EXPECT_EQ(picker.seconds(2) - streams, RoutePicker::kClamp);
-    EXPECT_EQ(picker.packet_seconds(2) - packets, 1.0);
-    for (int i = 0; i < 40; ++i) picker.record(2, 1.0, 3.0);
-    EXPECT_EQ(picker.pick(2).path, 1);  // the streams now dearer than the single rays
-    for (int i = 0; i < 400; ++i) picker.record(1, 1.0, 3.0);
-    EXPECT_EQ(picker.pick(2).path, 0);  // and both than the packets
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) EXPECT_EQ(picker.pick(1).path, 1);  // the prior
+    PickerRun run{picker, {3.0, 2.0, 1.0}};
+    const auto learning = static_cast<int>(3 * RoutePicker::kLearnRuns * RoutePicker::kRun);
+    EXPECT_EQ(run.take(learning, 1), learning);
+    EXPECT_EQ(run.paths_seen[0], run.paths_seen[1]);  // by turns
+    EXPECT_EQ(run.paths_seen[1], run.paths_seen[2]);
+    EXPECT_EQ(picker.fastest(0), 2);
+    EXPECT_EQ(picker.fastest(1), 2);
+    EXPECT_TRUE(picker.far(0, 2));
+    EXPECT_TRUE(picker.far(1, 2));
+    run.per_ray = {3.0, 2.0, 20.0};  // the streams now dearest: their timed runs raise their cost
+    run.take(40000, 2);
+    EXPECT_EQ(picker.fastest(2), 1);
+    EXPECT_FALSE(picker.far(0, 1));  // the packets within kFar of the single rays
+    EXPECT_TRUE(picker.far(2, 1));
 
-    // A partner without samples yet is not chosen, and keeps the choice from being clear.
+    // A path with nothing counted (every batch of its runs a warm-up) is not chosen, and keeps the
+    // choice from being clear.
     RoutePicker half(3);
-    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) half.pick(1);
-    half.record(1, 3.0, 1.0);
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior + 3 * RoutePicker::kLearnRuns * RoutePicker::kRun; ++i)
+        half.pick(1);
+    half.record(0, 3.0, 1);
+    half.record(1, 1.0, 1);
     EXPECT_EQ(half.cost(2), 0.0);
-    EXPECT_EQ(half.pick(0).path, 1);
-    RoutePicker close(3), clear(3);
-    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
-        close.record(1, 1.0, 3.0);  // the streams close to the packets: sampled often
-        close.record(2, 1.0, 1.2);
-        clear.record(1, 1.0, 3.0);
-        clear.record(2, 1.0, 2.0);
-    }
-    EXPECT_NEAR(sampled(close, 64000), 64000 / RoutePicker::kSample, 64000 / RoutePicker::kSample / 4);
-    EXPECT_NEAR(sampled(clear, 512000), 512000 / RoutePicker::kSampleFar, 512000 / RoutePicker::kSampleFar / 4);
+    EXPECT_EQ(half.fastest(0), 1);
+    EXPECT_FALSE(half.far(2, 1));
 }
 
-TEST(Routed, PickerSamplesFewBatchesOnceItKnows) {
+// Once the picker knows: one run in kSample is timed; a path within kFar of the fastest traces its
+// share of them, one that costs more than kFar times the fastest one in kSampleFar / kSample of
+// that share (the rest go to the fastest, timed).
+TEST(Routed, PickerTimesFewRunsOnceItKnows) {
     using detail::RoutePicker;
-    RoutePicker learning;
-    EXPECT_EQ(sampled(learning, RoutePicker::kPrior), 0);
-    EXPECT_NEAR(sampled(learning, 8000), 8000 / RoutePicker::kLearn, 8000 / RoutePicker::kLearn / 4);
+    const auto learning = static_cast<int>(RoutePicker::kPrior + 2 * RoutePicker::kLearnRuns * RoutePicker::kRun);
     RoutePicker close, clear;
-    for (std::uint64_t i = 0; i < RoutePicker::kLearned; ++i) {
-        close.record(1.0, 1.2);
-        clear.record(1.0, 3.0);
-    }
-    EXPECT_NEAR(sampled(close, 64000), 64000 / RoutePicker::kSample, 64000 / RoutePicker::kSample / 4);
-    EXPECT_NEAR(sampled(clear, 512000), 512000 / RoutePicker::kSampleFar, 512000 / RoutePicker::kSampleFar / 4);
+    PickerRun near_run{close, {1.0, 1.2}}, far_run{clear, {1.0, 3.0}};
+    EXPECT_EQ(near_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
+    EXPECT_EQ(far_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
+    PickerRun near{close, {1.0, 1.2}}, far{clear, {1.0, 3.0}};
+    const int n = 512000;
+    EXPECT_NEAR(near.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
+    EXPECT_NEAR(far.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
+    const int near_share = n / static_cast<int>(2 * RoutePicker::kSample);
+    const int far_share = n / static_cast<int>(2 * RoutePicker::kSampleFar);
+    EXPECT_NEAR(near.paths_seen[1], near_share, near_share / 4);
+    EXPECT_NEAR(far.paths_seen[1], far_share, far_share / 4);
 }
 
 // Measured or not, the route changes no answer, and the work counted is that of the path that
@@ -363,25 +385,25 @@ TEST(Routed, MeasuredRouteCountsOneTracingPerRay) {
     EXPECT_EQ(counters.rays, frame.primary.size());
 }
 
-// The three paths by name: `auto` holds the streams when told to (not by default: its paired samples
-// do not yet choose among three reliably, docs/INCOHERENT.md), and only when it measures.
+// The three paths by name: `auto` holds the streams unless told not to, and only when it measures
+// (coherence alone never names them).
 TEST(Routed, StreamsAreAThirdPathOfTheMeasuredRoute) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
     auto streams = [&](const std::string& spec) {
         return make_accelerator(scene.triangles, parse_accel_config(spec))->stats().setting("streams").value_or("");
     };
-    EXPECT_EQ(streams("auto"), "off");
-    EXPECT_EQ(streams("auto@streams=on"), "on");
-    EXPECT_EQ(streams("auto@streams=on,route=coherence"), "off");
+    EXPECT_EQ(streams("auto"), "on");
+    EXPECT_EQ(streams("auto@streams=off"), "off");
+    EXPECT_EQ(streams("auto@route=coherence"), "off");
     EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@streams=maybe")), Error);
 }
 
-// A batch kind the streams trace fastest goes to them: sampled batches are traced by all three paths
-// with the same answers, and the work counted is one tracing per ray whichever path answered.
+// While it learns, the route gives runs of batches to each of the three paths, with the same
+// answers, and the work counted is one tracing per ray whichever path answered.
 TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
-    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto@streams=on"));
+    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto"));
     for (int round = 0; round < 3; ++round) {  // enough batches to learn and sample
         std::vector<Hit> hits(ref.rays.size());
         std::vector<std::uint8_t> occluded(ref.rays.size());
@@ -394,6 +416,13 @@ TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
         EXPECT_EQ(hits, ref.hits);
         EXPECT_EQ(occluded, ref.occluded);
         EXPECT_EQ(counters.rays, ref.rays.size());
+    }
+    // Each path answered some of them: "closest packets P single S stream T; any ...".
+    const std::string routes = routed->stats().setting("routed").value_or("");
+    for (const char* path : {" packets ", " single ", " stream "}) {
+        const std::size_t at = routes.find(path);
+        ASSERT_NE(at, std::string::npos) << routes;
+        EXPECT_GT(std::stod(routes.substr(at + std::string(path).size())), 0.0) << path << "in: " << routes;
     }
 }
 

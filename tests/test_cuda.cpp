@@ -4,13 +4,18 @@
 // what the backend says without a device, or without CUDA in the build, is tested everywhere.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
+#include "accel/local_store_registry.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
@@ -90,6 +95,90 @@ TEST(CudaRefusals, InTheLibrarysWords) {
     }
 }
 
+// Memory mode (b)'s parameters are read before any device is needed: a bad layout is refused in one
+// line on any machine with the CUDA backend built.
+TEST(CudaRefusals, SharedMemoryLayouts) {
+    const std::vector<Triangle> tri = {{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}}};
+    auto expect_refused = [&](std::map<std::string, std::string> params, const std::string& why) {
+        AccelConfig c = cuda_config("kd");
+        c.params = std::move(params);
+        const std::string e = test::error_of([&] { make_accelerator(tri, c); });
+#ifdef CELLRT_HAVE_CUDA
+        EXPECT_EQ(e, why);
+#else
+        EXPECT_EQ(e, "device 'cuda': " + cuda_device_info().reason) << why;
+#endif
+    };
+    expect_refused({{"memory", "shared"}, {"node_line", "48"}}, "cuda parameter node_line=48: a line is a power of two bytes");
+    expect_refused({{"triangle_ways", "4"}},
+                   "cuda parameter triangle_ways=4 shapes the shared-memory caches: it needs memory=shared");
+}
+
+// `cache-study --device cuda` checks its options before it looks for the device, and without one it
+// fails in one line and writes nothing.
+TEST(CudaRefusals, CacheStudyOnTheDevice) {
+    const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
+    const std::string study = "cache-study builtin:spheres?tris=200 --size 16x16 -o " + dir.string() + " --device ";
+    const auto [async, async_status] = run_cli(study + "cuda --access async");
+    EXPECT_EQ(async_status, 1) << async;
+    EXPECT_EQ(async, "cellrt: error: --access async: the GPU's shared-memory caches read synchronously (docs/GPU.md)\n");
+    const auto [other, other_status] = run_cli(study + "tpu");
+    EXPECT_EQ(other_status, 1) << other;
+    EXPECT_EQ(other, "cellrt: error: --device 'tpu' is not one of: cpu, cuda\n");
+    if (!have_gpu()) {
+        const auto [out, status] = run_cli(study + "cuda");
+        EXPECT_EQ(status, 1) << out;
+        EXPECT_EQ(out, "cellrt: error: --device cuda: no device (" + cuda_device_info().reason + ")\n");
+    }
+    EXPECT_FALSE(fs::exists(dir));
+}
+
+// The study's sweeps on the GPU: one CSV row per run, as the model writes, each run's lookups those of
+// the model's run with the same layouts (a read's lookups depend on its address and size only), its
+// time measured (frame_ms) and none modelled (cycles 0).
+TEST(CudaCacheStudy, SameRunsAndLookupsAsTheModel) {
+    REQUIRE_GPU();
+    const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
+    const std::string study = "cache-study builtin:spheres?tris=2000 --size 64x64 --sample 1 --structures kd bih "
+                              "--traversals branched --access sync --overwrite -o ";
+    for (const char* device : {"cpu", "cuda"}) {
+        const auto [out, status] = run_cli(study + (dir / device).string() + " --device " + device);
+        ASSERT_EQ(status, 0) << out;
+    }
+    auto rows = [&](const char* device) {
+        std::ifstream in(dir / device / "cache_study.csv");
+        std::vector<std::vector<std::string>> out;
+        for (std::string line; std::getline(in, line);) {
+            std::vector<std::string> cells;
+            std::stringstream fields(line);
+            for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(cell);
+            out.push_back(cells);
+        }
+        return out;
+    };
+    const auto cpu = rows("cpu"), gpu = rows("cuda");
+    ASSERT_EQ(gpu.size(), cpu.size());
+    ASSERT_GT(gpu.size(), 1u);
+    EXPECT_EQ(gpu[0], cpu[0]);  // the header
+    const auto& h = cpu[0];
+    auto at = [&](const std::vector<std::string>& row, const std::string& column) {
+        return row[static_cast<std::size_t>(std::find(h.begin(), h.end(), column) - h.begin())];
+    };
+    for (std::size_t i = 1; i < gpu.size(); ++i) {
+        for (const char* same : {"structure", "sweep", "node_layout", "tri_layout", "rays"})
+            EXPECT_EQ(at(gpu[i], same), at(cpu[i], same)) << "row " << i << " " << same;
+        for (const char* cache : {"node", "tri"}) {
+            const std::string c(cache);
+            EXPECT_EQ(std::stoull(at(gpu[i], c + "_hits")) + std::stoull(at(gpu[i], c + "_misses")),
+                      std::stoull(at(cpu[i], c + "_hits")) + std::stoull(at(cpu[i], c + "_misses")))
+                << "row " << i << " " << c << " lookups";
+        }
+        EXPECT_EQ(at(gpu[i], "cycles"), "0");
+        EXPECT_GT(std::stod(at(gpu[i], "frame_ms")), 0.0) << "row " << i;
+    }
+    fs::remove_all(dir);
+}
+
 class CudaAgainstBruteForce : public testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
 TEST_P(CudaAgainstBruteForce, SameHits) {
@@ -161,6 +250,60 @@ TEST(CudaResident, SameAnswersAndWorkAsTheHost) {
         EXPECT_EQ(on_device.triangles, on_host.triangles) << spec;
         EXPECT_THROW(batch.upload(std::vector<Ray>(ref.rays.size() + 1)), Error);
     }
+}
+
+// Memory mode (b): through the blocks' shared-memory caches every tree and traversal returns the
+// brute-force hits; the blocks look up exactly the lines the local-store model looks up for the same
+// reads (a read's lookups depend only on its address and size), whatever the interleaving of the
+// block's threads makes of hits and misses.
+TEST(CudaSharedMemory, SameHitsAndLookupsAsTheModel) {
+    REQUIRE_GPU();
+    const std::string name = "builtin:city?tris=20000";
+    const Scene& scene = test::cached_scene(name);
+    const test::ReferenceAnswers& ref = test::cached_reference(name, scene.triangles);
+    for (const std::string& spec : kCudaConfigs) {
+        for (const char* ways : {"1", "4"}) {
+            AccelConfig c = cuda_config(spec);
+            c.params.insert({{"memory", "shared"}, {"node_line", "64"}, {"node_sets", "64"}, {"node_ways", ways},
+                             {"triangle_line", "128"}, {"triangle_sets", "32"}, {"triangle_ways", ways}});
+            const std::string what = "cuda " + spec + " memory=shared ways " + ways;
+            const auto device = make_device_accelerator(scene.triangles, c);
+            test::expect_matches(*device, ref, what);
+            const DeviceCacheStats before = device->cache_stats();
+            std::vector<Hit> hits(ref.rays.size());
+            device->intersect(ref.rays, hits);
+            const DeviceCacheStats s = device->cache_stats();
+            EXPECT_TRUE(hits == ref.hits) << what;
+            LocalStoreConfig model_config;
+            model_config.node_cache = {64, 64, static_cast<std::uint32_t>(std::stoi(ways))};
+            model_config.triangle_cache = {128, 32, static_cast<std::uint32_t>(std::stoi(ways))};
+            AccelConfig cpu = parse_accel_config(spec);
+            const auto model = make_local_store_accelerator(scene.triangles, cpu, model_config);
+            model->intersect(ref.rays, hits);
+            const LocalStoreStats m = model->local_store_stats();
+            EXPECT_EQ(s.node_cache.lookups() - before.node_cache.lookups(), m.node_cache.hits + m.node_cache.misses)
+                << what;
+            EXPECT_EQ(s.triangle_cache.lookups() - before.triangle_cache.lookups(),
+                      m.triangle_cache.hits + m.triangle_cache.misses)
+                << what;
+            EXPECT_GT(s.node_cache.hits, 0u) << what;
+            EXPECT_GT(s.blocks, before.blocks) << what;
+            const auto& settings = device->stats().settings;
+            EXPECT_TRUE(std::any_of(settings.begin(), settings.end(), [](const auto& kv) {
+                return kv.first == "memory" && kv.second.rfind("shared: ", 0) == 0;
+            })) << what;
+        }
+    }
+}
+
+// A layout over the device's shared memory per block is refused in one line.
+TEST(CudaSharedMemory, CachesOverTheBudgetAreRefused) {
+    REQUIRE_GPU();
+    const std::vector<Triangle> tri = {{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}}};
+    AccelConfig c = cuda_config("bih");
+    c.params = {{"memory", "shared"}, {"node_line", "4096"}, {"node_sets", "64"}};
+    const std::string e = test::error_of([&] { make_accelerator(tri, c); });
+    EXPECT_NE(e.find("B of shared memory a block of this device has"), std::string::npos) << e;
 }
 
 // `render --device cuda` writes the CPU's image, bit for bit, under every shading.

@@ -7,13 +7,16 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <type_traits>
 
 #include "accel/structures.hpp"
 #include "cellrt/accel.hpp"
+#include "cuda/device_memory.hpp"
 #include "cuda/device_trace.hpp"
 #include "cuda/device_tree.hpp"
+#include "cuda/shared_cache.hpp"
 #include "ray_suite.hpp"
 #include "structure_cases.hpp"
 
@@ -21,36 +24,74 @@ namespace cellrt {
 namespace {
 
 // A tree packed into one 16-byte aligned buffer and traced ray by ray with the device's per-thread
-// functions, behind the accelerator boundary so that the suite's comparison applies as it is.
+// functions, behind the accelerator boundary so that the suite's comparison applies as it is: in
+// global memory (mode (a)), or with `memory.shared` through a block's shared-memory caches (mode (b),
+// cuda/shared_cache.hpp), here a host array emptied at each call as a block's are at each launch.
+class CacheTracer : public Accelerator {
+public:
+    virtual DeviceCacheStats caches() const = 0;  // mode (b): the caches' counts over every call so far
+};
+
 template <class S, class Kernel>
-class PackedTracer final : public Accelerator {
+class PackedTracer final : public CacheTracer {
 public:
     using Traits = typename S::Traits;
-    explicit PackedTracer(const S& s)
-        : layout_(detail::packed_layout<Traits>(s.nodes().size(), s.entries().size(), s.triangle_array().size(),
+    explicit PackedTracer(const S& s, const detail::DeviceMemoryConfig& memory = {})
+        : memory_(memory),
+          layout_(detail::packed_layout<Traits>(s.nodes().size(), s.entries().size(), s.triangle_array().size(),
                                                 s.bounds())),
           bytes_(static_cast<std::byte*>(::operator new(layout_.bytes, std::align_val_t{detail::kPackedAlignment}))) {
         detail::pack_tree<Traits>(s.nodes(), s.entries(), s.triangle_array(), layout_, bytes_.get());
     }
     AccelStats stats() const override { return {}; }
+    DeviceCacheStats caches() const override {
+        const std::lock_guard lock(mutex_);
+        return cache_stats_;
+    }
 
 private:
     struct Free {
         void operator()(std::byte* p) const { ::operator delete(p, std::align_val_t{detail::kPackedAlignment}); }
     };
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        const auto view = detail::packed_view<Traits>(bytes_.get(), layout_);
-        detail::RayCounters c;
-        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = detail::trace_closest<Traits, Kernel>(view, rays[i], c);
-        add(c, rays.size(), counters);
+        with_memory([&](const auto& view, auto& mem) {
+            detail::RayCounters c;
+            for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = detail::trace_closest<Traits, Kernel>(view, mem, rays[i], c);
+            add(c, rays.size(), counters);
+        });
     }
     void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                      TraversalCounters* counters) const override {
+        with_memory([&](const auto& view, auto& mem) {
+            detail::RayCounters c;
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                occluded[i] = detail::trace_any<Traits, Kernel>(view, mem, rays[i], c) ? 1 : 0;
+            add(c, rays.size(), counters);
+        });
+    }
+    // Calls fn(view, memory policy) with the policy of the memory mode.
+    template <class Fn>
+    void with_memory(Fn&& fn) const {
         const auto view = detail::packed_view<Traits>(bytes_.get(), layout_);
-        detail::RayCounters c;
-        for (std::size_t i = 0; i < rays.size(); ++i)
-            occluded[i] = detail::trace_any<Traits, Kernel>(view, rays[i], c) ? 1 : 0;
-        add(c, rays.size(), counters);
+        if (!memory_.shared) {
+            auto mem = view.memory();
+            fn(view, mem);
+            return;
+        }
+        std::vector<std::uint32_t> storage(memory_.shared_bytes() / 4);
+        auto* at = reinterpret_cast<std::byte*>(storage.data());
+        const detail::SharedCache nodes(at, memory_.node_cache), triangles(at + memory_.node_cache.bytes(),
+                                                                          memory_.triangle_cache);
+        nodes.clear(0, 1);
+        triangles.clear(0, 1);
+        const detail::CacheAddressMap map =
+            detail::cache_address_map(view, layout_.nodes, layout_.entries, layout_.triangles);
+        detail::SharedCacheMemory<typename Traits::Node> mem(nodes, triangles, map);
+        fn(view, mem);
+        const std::lock_guard lock(mutex_);
+        cache_stats_.node_cache += mem.node_counts;
+        cache_stats_.triangle_cache += mem.triangle_counts;
+        ++cache_stats_.blocks;
     }
     static void add(const detail::RayCounters& c, std::size_t rays, TraversalCounters* counters) {
         if (!counters) return;
@@ -60,24 +101,27 @@ private:
         counters->triangles += c.triangles;
     }
 
+    detail::DeviceMemoryConfig memory_;
     detail::PackedTree layout_;
     std::unique_ptr<std::byte, Free> bytes_;
+    mutable std::mutex mutex_;
+    mutable DeviceCacheStats cache_stats_;
 };
 
 // The host's own closest-hit batch loop over a tree's own arrays, as its single-ray accelerator runs it.
 using HostPath = std::function<void(std::span<const Ray>, std::span<Hit>, TraversalCounters*)>;
 
 // Calls check(name, tracer, host) for every listed tree and traversal, the tree built over `tris` as
-// the host's single-ray path builds it.
+// the host's single-ray path builds it, the tracer reading it in `memory`'s mode.
 template <class Check>
-void for_every_device_kernel(std::span<const Triangle> tris, Check&& check) {
+void for_every_device_kernel(std::span<const Triangle> tris, Check&& check, const detail::DeviceMemoryConfig& memory = {}) {
     detail::TreeStructures::for_each([&]<class S>(std::type_identity<S>) {
         AccelConfig config;
         config.kind = S::kName;
         const S s(tris, config);
         for (const auto& t : S::kTraversals) {
             S::with_kernel(t.value, [&](auto kernel) {
-                const PackedTracer<S, decltype(kernel)> tracer(s);
+                const PackedTracer<S, decltype(kernel)> tracer(s, memory);
                 const HostPath host = [&](std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* c) {
                     auto mem = s.view().memory();
                     detail::closest_hits(s.bounds(), rays, hits, c, [&](const detail::TraversalRay& r, auto& q,
@@ -117,12 +161,67 @@ TEST_P(DeviceCode, SameHitsAndWorkAsTheHost) {
 INSTANTIATE_TEST_SUITE_P(Scenes, DeviceCode, testing::ValuesIn(test::structure_scene_names()),
                          [](const auto& info) { return test::test_name(info.param); });
 
+// Memory mode (b) on the host: small caches, so that lines are evicted all the time and objects
+// straddle lines (12-byte BIH nodes in 32-byte lines, 36-byte triangles in 64-byte ones).
+detail::DeviceMemoryConfig small_shared_caches() {
+    detail::DeviceMemoryConfig m;
+    m.shared = true;
+    m.node_cache = {32, 64, 4};
+    m.triangle_cache = {64, 32, 1};
+    return m;
+}
+
+class DeviceCodeSharedCaches : public testing::TestWithParam<std::string> {};
+
+// Through the block's software caches the kernels read the same bytes, so they return the
+// brute-force hits and do the host's work exactly; every lookup is counted, and on the host (one
+// thread a cache) none is torn or unfilled.
+TEST_P(DeviceCodeSharedCaches, SameHitsAndWorkAsTheHost) {
+    const Scene* scene = test::structure_scene(GetParam());
+    if (!scene) GTEST_SKIP() << "scene " << GetParam() << " not found under " << test::scenes_dir();
+    const test::ReferenceAnswers& ref = test::cached_reference(GetParam(), scene->triangles);
+    for_every_device_kernel(
+        scene->triangles,
+        [&](const std::string& name, const Accelerator& tracer, const HostPath& host_path) {
+            test::expect_matches(tracer, ref, "shared-memory caches " + name + " on " + GetParam());
+            const std::span<const Ray> some = std::span(ref.rays).first(std::min<std::size_t>(ref.rays.size(), 20000));
+            std::vector<Hit> hits(some.size());
+            TraversalCounters device, host;
+            const DeviceCacheStats before = dynamic_cast<const CacheTracer&>(tracer).caches();
+            tracer.intersect(some, hits, &device);
+            const DeviceCacheStats after = dynamic_cast<const CacheTracer&>(tracer).caches();
+            host_path(some, hits, &host);
+            EXPECT_GT(host.triangles, 0u) << name;
+            EXPECT_EQ(device.nodes, host.nodes) << name;
+            EXPECT_EQ(device.leaves, host.leaves) << name;
+            EXPECT_EQ(device.triangles, host.triangles) << name;
+            const DeviceCacheCounts& n = after.node_cache;
+            const DeviceCacheCounts& t = after.triangle_cache;
+            // At least one node lookup per node visited and leaf reached, one triangle lookup per test.
+            EXPECT_GE(n.lookups() - before.node_cache.lookups(), host.nodes + host.leaves) << name;
+            EXPECT_GE(t.lookups() - before.triangle_cache.lookups(), host.triangles) << name;
+            EXPECT_GT(n.hits, 0u) << name;
+            EXPECT_GT(n.evictions, 0u) << name;
+            EXPECT_EQ(n.torn + n.unfilled + t.torn + t.unfilled, 0u) << name;
+        },
+        small_shared_caches());
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, DeviceCodeSharedCaches, testing::ValuesIn(test::structure_scene_names()),
+                         [](const auto& info) { return test::test_name(info.param); });
+
 TEST(DeviceCodeDegenerate, SameHitsAsBruteForce) {
     for (const auto& [what, tris] : test::degenerate_scenes()) {
         const test::ReferenceAnswers ref = test::reference_suite(tris, test::small_suite());
         for_every_device_kernel(tris, [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
             test::expect_matches(tracer, ref, "device code " + name + " on " + what);
         });
+        for_every_device_kernel(
+            tris,
+            [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
+                test::expect_matches(tracer, ref, "shared-memory caches " + name + " on " + what);
+            },
+            small_shared_caches());
     }
 }
 

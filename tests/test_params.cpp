@@ -12,6 +12,7 @@
 #include "cellrt/accel.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
+#include "cuda/device_memory.hpp"
 
 namespace cellrt {
 namespace {
@@ -50,6 +51,8 @@ TEST(Params, DocumentsPrintTheTablesThatValidate) {
     for (const auto& [kind, file] : docs)
         EXPECT_EQ(documented_table(read_text(kDocs / file), kind), param_table_markdown(accelerator_params(kind)))
             << "docs/" << file << " against the table of " << kind;
+    EXPECT_EQ(documented_table(read_text(kDocs / "GPU.md"), "cuda"), param_table_markdown(detail::device_memory_params()))
+        << "docs/GPU.md against the CUDA backend's memory parameters";
 }
 
 // Every default the tables print is accepted as a user's value, and giving every parameter at its

@@ -7,7 +7,8 @@
 #   tools/device-check.sh run DIR       # there, in one go (about 8 minutes at most): results under $OUT
 #
 # `run` writes $OUT/info.txt (`cellrt info --device cuda`), $OUT/gpu_tests.json (the GPU tests, GoogleTest's
-# JSON), $OUT/gpu_bench.json and .md (the GPU benchmark beside Embree on all host cores, same rays), and
+# JSON), $OUT/gpu_bench.json and .md (the GPU benchmark beside Embree on all host cores, same rays),
+# $OUT/cache_study/ (the study's cache sweeps in the GPU's shared memory, memory mode (b)), and
 # $OUT/scaling_pull_16core.json (the CPU scaling curve, docs/SCALING.md), each step under a time limit
 # of its own, and $OUT/summary.json with each step's exit status and seconds.
 # With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=560).
@@ -69,6 +70,8 @@ run)
   timed gpu_bench 240 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza sibenik bunny builtin:city \
     --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$out/gpu_bench.json"
   cp "$out/gpu_bench.log" "$out/gpu_bench.md"
+  timed cache_study 75 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda --size 1920x1080 \
+    --sample 4 --structures kd bih --traversals branched -o "$out/cache_study"
   timed scaling 100 "$run" cellrt_scaling --scenes-dir "$CELLRT_SCENES" --dispatch pull --packets 16 --repeats 3 \
     --workers 1 2 4 8 12 16 --configs embree:single kd+auto bih+auto --json "$out/scaling_pull_16core.json"
   rm -rf "$CELLRT_TEST_CACHE"

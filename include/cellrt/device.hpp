@@ -58,12 +58,36 @@ private:
     std::uint8_t* occluded_ = nullptr;
 };
 
+// What memory mode (b)'s software caches in shared memory counted (docs/GPU.md), as the local-store
+// model's CacheStats counts: a read looks up every line its object overlaps. A lookup that finds the
+// line is a hit, one that does not a miss (it fills the line, or, of those, `unfilled` ones read
+// global memory because another thread of the block was filling the slot); a lookup that finds the
+// line but sees it replaced while copying it out reads global memory too and counts as `torn`, not
+// as a hit. Only concurrent threads make the last two: one thread a cache (the host's tests) never.
+struct DeviceCacheCounts {
+    unsigned long long hits = 0, misses = 0, evictions = 0, torn = 0, unfilled = 0;
+
+    unsigned long long lookups() const { return hits + misses + torn; }
+    DeviceCacheCounts& operator+=(const DeviceCacheCounts& o) {
+        hits += o.hits; misses += o.misses; evictions += o.evictions; torn += o.torn; unfilled += o.unfilled;
+        return *this;
+    }
+};
+
+// The counts of every block of every launch so far, summed; all zero in memory mode (a).
+struct DeviceCacheStats {
+    DeviceCacheCounts node_cache, triangle_cache;  // nodes and leaf entries; triangles
+    unsigned long long blocks = 0;                 // blocks launched with the caches
+};
+
 class DeviceAccelerator : public Accelerator {
 public:
     // Trace a resident batch in place; return the kernel's own time in seconds (CUDA events: no
     // transfer, no launch set-up on the host). Counters as for intersect().
     virtual double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
     virtual double occluded_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
+    // Memory mode (b)'s cache counts over every call so far, host and resident batches alike.
+    virtual DeviceCacheStats cache_stats() const = 0;
 };
 
 }  // namespace cellrt

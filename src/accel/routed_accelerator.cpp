@@ -71,9 +71,7 @@ private:
     }
 
     // Traces the batch on the path coherence names (the packets or the BVH's single rays) or, when
-    // measured, on the one its kind's picker names; a sampled batch on the packets and the picker's
-    // partner instead (RoutePicker), its work counted once: on the path chosen when it is one of the
-    // two, else on the partner (the answers are the same).
+    // measured, on the one its kind's picker names, timing it when the picker asks (RoutePicker).
     // `query` is 0 for closest hits, 1 for any.
     template <class Trace>
     void route(std::span<const Ray> rays, int query, Trace&& trace, TraversalCounters* counters) const {
@@ -82,26 +80,19 @@ private:
             count_rays(query, prior, rays.size());
             return trace(*paths_[prior], counters);
         }
-        RoutePicker& picker = pickers_[2 * query + prior];
+        const int kind = 2 * query + prior;
+        RoutePicker& picker = pickers_[kind];
         const RoutePicker::Choice choice = picker.pick(prior);
-        if (!choice.sampled) {
-            count_rays(query, choice.path, rays.size());
-            return trace(*paths_[choice.path], counters);
-        }
-        const int counted = choice.path == 0 ? 0 : choice.partner;
-        count_rays(query, counted, rays.size());
-        // The packets and the partner, in either order by turns, so that neither always finds the
-        // rays in the cache (every other pair of turns: the partners alternate on every turn).
-        double seconds[2];
-        const int paths[2] = {0, choice.partner};
-        const unsigned first = turn_.fetch_add(1, std::memory_order_relaxed) >> 1 & 1u;
-        for (const unsigned i : {first, 1u - first}) {
-            const int path = paths[i];
-            const double start = thread_seconds();
-            trace(*paths_[path], path == counted ? counters : nullptr);
-            seconds[i] = thread_seconds() - start;
-        }
-        if (choice.counts) picker.record(choice.partner, seconds[0], seconds[1]);
+        count_rays(query, choice.path, rays.size());
+        // The path of this thread's previous batch of the kind: a timed batch counts only when it is
+        // the same, so that the path's nodes are as warm as the chosen path's are between batches.
+        LastPath& last = last_path_[kind];
+        const bool warm = last.owner == this && last.path == choice.path;
+        last = {this, choice.path};
+        if (!choice.timed) return trace(*paths_[choice.path], counters);
+        const double start = thread_seconds();
+        trace(*paths_[choice.path], counters);
+        if (warm) picker.record(choice.path, thread_seconds() - start, rays.size());
     }
 
     void count_rays(int query, int path, std::size_t n) const {
@@ -109,7 +100,7 @@ private:
     }
     // Which path answered how many rays so far, per query: "closest packets/single/stream, any ..."
     // as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
-    // was sampled, each path's mean time per sample in microseconds.
+    // was timed, the batches counted and each path's time per ray in nanoseconds (0: none counted).
     std::string routed() const {
         std::string out;
         for (int q = 0; q < 2; ++q) {
@@ -126,10 +117,10 @@ private:
         for (int k = 0; k < 4; ++k) {
             const RoutePicker& picker = pickers_[k];
             if (picker.samples() == 0) continue;
-            out += std::string("; sampled ") + kKinds[k] + " (" + std::to_string(picker.samples()) + "), time over the packets'";
-            for (int p = 1; p < count_; ++p) {
+            out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) + " batches), ns per ray";
+            for (int p = 0; p < count_; ++p) {
                 char buf[48];
-                std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], picker.cost(p));
+                std::snprintf(buf, sizeof buf, " %s %.1f", kPathNames[p], 1e9 * picker.cost(p));
                 out += buf;
             }
         }
@@ -144,9 +135,16 @@ private:
     bool measured_;
     // One per kind of batch: closest or any hit, coherent or not.
     mutable std::array<RoutePicker, 4> pickers_;
-    mutable std::atomic<unsigned> turn_{0};
+    // Per thread and kind of batch, the router and the path of the thread's last batch (route()).
+    struct LastPath {
+        const RoutedAccelerator* owner = nullptr;
+        int path = -1;
+    };
+    static thread_local std::array<LastPath, 4> last_path_;
     mutable std::atomic<std::uint64_t> routed_[2][3]{};  // rays answered, per query and path
 };
+
+thread_local std::array<RoutedAccelerator::LastPath, 4> RoutedAccelerator::last_path_;
 
 }  // namespace
 
@@ -175,12 +173,12 @@ const ParamTable& routed_params() {
          "any other to the wide BVH (with route=measured: the first guess for its kind of batch)"},
         {"route", choice, "measured", 0, 0, {"measured", "coherence"},
          "measured: each kind of batch (closest or any hit, coherent or not) goes to the path that took "
-         "less time on a sample of them, traced by all; coherence: by coherence alone, the same path "
-         "(and work counts) in every run"},
-        {"streams", choice, "off", 0, 0, {"on", "off"},
-         "on: the measured route also samples the wide BVH's stream traversal (bvh:stream) as a third path "
-         "and takes it for the kinds of batch it traces fastest (not yet reliable: docs/INCOHERENT.md, "
-         "Ray streams); off: packets and single rays only"},
+         "the least time per ray over runs of such batches given to each path in turn; coherence: by "
+         "coherence alone, the same path (and work counts) in every run"},
+        {"streams", choice, "on", 0, 0, {"on", "off"},
+         "on: the measured route also times the wide BVH's stream traversal (bvh:stream) as a third path "
+         "and takes it for the kinds of batch it traces fastest (AO and many bounces); off: packets and "
+         "single rays only"},
     };
     return table;
 }

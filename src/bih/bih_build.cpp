@@ -22,7 +22,8 @@
 // three at once, in four-float vectors), and one partitions the range and bounds the two children's
 // centres and boxes, which their own decisions then need; the cost sweeps visit non-empty bins only.
 // Large ranges are built as parallel tasks (kernel/subtree.hpp keeps the layout independent of the
-// thread count), and the largest are also binned by several threads in blocks combined in order.
+// thread count), and the largest are also binned by several threads in blocks combined in order, as
+// are the passes over all triangles before and after the tree's.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -44,7 +45,8 @@ namespace cellrt::detail {
 namespace {
 
 constexpr std::size_t kParallelMin = 4096;
-// Ranges binned by several threads (BihBuildParams::parallel_pass_min) are cut in blocks of this many.
+// Ranges binned by several threads (BihBuildParams::parallel_pass_min), and the passes over all
+// triangles of a parallel build, are cut in blocks of this many.
 constexpr std::size_t kBlock = 16384;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -161,6 +163,13 @@ struct Bounds {
         if constexpr (order == Order::ascending) return bound < v ? v : bound;
         else return v < bound ? bound : v;
     }
+    // Takes the bounds of triangles that come after this one's, as a pass in ascending order would.
+    void merge(const Bounds& later) {
+        lo = lower<Order::ascending>(lo, later.lo);
+        hi = higher<Order::ascending>(hi, later.hi);
+        centre_lo = lower<Order::ascending>(centre_lo, later.centre_lo);
+        centre_hi = higher<Order::ascending>(centre_hi, later.centre_hi);
+    }
     void store(Range& r) const {
         r.centres = {{centre_lo[0], centre_lo[1], centre_lo[2]}, {centre_hi[0], centre_hi[1], centre_hi[2]}};
         r.objects = {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
@@ -205,43 +214,71 @@ struct Bins {
 
 class BihBuilder {
 public:
-    BihBuilder(std::span<const Triangle> tris, const BihBuildParams& p) : tris_(tris), p_(p) {
-        items_.resize(tris.size());
-        for (std::uint32_t i = 0; i < items_.size(); ++i) items_[i] = {tris[i].bounds(), i};
-    }
+    BihBuilder(std::span<const Triangle> tris, const BihBuildParams& p) : tris_(tris), p_(p) {}
 
     BihTree build() {
         BihTree tree;
-        Range root{0, static_cast<std::uint32_t>(tris_.size()), {}, {}, {}, {}, 0};
-        for (const Item& it : items_) {
-            root.objects.extend(it.box);
-            root.centres.extend(it.centre());
-        }
-        root.box = root.objects;
-        if (tris_.empty()) root.box = Box3{Vec3(0.f), Vec3(0.f)};
-        root.grid = root.box;
-        tree.bounds = root.box;
-        std::unique_ptr<Subtree<BihNode>> top;
-        auto run = [&] { top = subtree(root); };
+        auto run = [&] { build_into(tree); };
         if (p_.threads == 1) {
             run();
         } else {
             tbb::task_arena arena(build_concurrency(p_.threads));
             arena.execute(run);
         }
-        tree.nodes = {BihNode{}, BihNode::leaf(0, 0)};
-        std::vector<std::uint32_t> no_indices;
-        flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
-        tree.triangles.reserve(tris_.size());
-        tree.prims.reserve(tris_.size());
-        for (const Item& it : items_) {
-            tree.triangles.push_back(tris_[it.triangle]);
-            tree.prims.push_back(it.triangle);
-        }
         return tree;
     }
 
 private:
+    // The whole build. Besides the tree's tasks, the passes over all triangles (their boxes and the
+    // root's bounds before, the reordered copy after) run in blocks on several threads, so that they
+    // do not bound a parallel build's speed-up (Amdahl): bounds are taken per block and combined in
+    // block order, which keeps the bits of one pass (Bounds), so the tree is the same at any count.
+    void build_into(BihTree& tree) {
+        const std::size_t n = tris_.size();
+        items_.resize(n);
+        std::vector<Bounds> blocks((n + kBlock - 1) / kBlock);
+        for_blocks(n, [&](std::size_t begin, std::size_t end) {
+            Bounds& b = blocks[begin / kBlock];
+            for (std::size_t i = begin; i < end; ++i) {
+                items_[i] = {tris_[i].bounds(), static_cast<std::uint32_t>(i)};
+                b.take<Order::ascending>(items_[i]);
+            }
+        });
+        Bounds all;
+        for (const Bounds& b : blocks) all.merge(b);
+        Range root{0, static_cast<std::uint32_t>(n), {}, {}, {}, {}, 0};
+        all.store(root);
+        root.box = root.objects;
+        if (n == 0) root.box = Box3{Vec3(0.f), Vec3(0.f)};
+        root.grid = root.box;
+        tree.bounds = root.box;
+        const std::unique_ptr<Subtree<BihNode>> top = subtree(root);
+        tree.nodes = {BihNode{}, BihNode::leaf(0, 0)};
+        std::vector<std::uint32_t> no_indices;
+        flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
+        tree.triangles.resize(n);
+        tree.prims.resize(n);
+        for_blocks(n, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) {
+                tree.triangles[i] = tris_[items_[i].triangle];
+                tree.prims[i] = items_[i].triangle;
+            }
+        });
+    }
+
+    // Calls body(begin, end) for [0, n) in blocks of kBlock: on several threads in a parallel build
+    // (within its arena), in order on one. No block's work may depend on another's.
+    template <class Body>
+    void for_blocks(std::size_t n, Body&& body) const {
+        const std::size_t count = (n + kBlock - 1) / kBlock;
+        auto block = [&](std::size_t b) { body(b * kBlock, std::min(n, (b + 1) * kBlock)); };
+        if (p_.threads == 1 || count < 2) {
+            for (std::size_t b = 0; b < count; ++b) block(b);
+            return;
+        }
+        tbb::parallel_for(std::size_t{0}, count, block);
+    }
+
     enum class Kind { leaf, split, cut };
     struct Decision {
         Kind kind = Kind::leaf;

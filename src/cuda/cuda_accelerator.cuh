@@ -1,18 +1,22 @@
 // A tree on the GPU behind the accelerator boundary: built on the host by its descriptor `S` (the same
 // tree the CPU paths trace), packed (device_tree.hpp) and copied to the device once; traced there by
-// the descriptor's own kernels, one ray per thread (trace_kernels.cuh). Host batches are copied in and
+// the descriptor's own kernels, one ray per thread (trace_kernels.cuh), in the memory mode its -P
+// parameters choose (device_memory.hpp: the tree in global memory, or the study's software caches in
+// shared memory). Host batches are copied in and
 // out in the calling thread's own stream, so calls from many threads run at once, as the boundary
 // requires (accelerator.hpp).
 #pragma once
 
 #include <cuda_runtime.h>
 
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "cellrt/device.hpp"
 #include "core/timer.hpp"
 #include "cuda/cuda_check.cuh"
+#include "cuda/device_memory.hpp"
 #include "cuda/trace_kernels.cuh"
 #include "kernel/named.hpp"
 #include "kernel/param_reader.hpp"
@@ -25,9 +29,10 @@ public:
     CudaAccelerator(std::span<const Triangle> triangles, const AccelConfig& config)
         : traversal_name_(choose_traversal(names_of(S::kTraversals), config.traversal, S::kName)),
           traversal_(value_named(S::kTraversals, traversal_name_, "traversal")),
+          memory_(read_device_memory(config)),
           device_(require_cuda_device()) {
         Timer timer;
-        const S s(triangles, config);
+        const S s(triangles, without_device_memory(config));
         stats_.build_seconds = timer.seconds();
         stats_.name = S::kName;
         stats_.traversal = traversal_name_;
@@ -36,8 +41,13 @@ public:
         stats_.tree = s.report();
         stats_.settings = s.settings();
         stats_.settings.push_back({"device", "cuda: " + device_.name});
+        stats_.settings.push_back({"memory", memory_.to_string()});
         layout_ = packed_layout<typename S::Traits>(s.nodes().size(), s.entries().size(), s.triangle_array().size(),
                                                    s.bounds());
+        check_shared_memory(memory_, device_.shared_memory_per_block,
+                            cache_address_map(TreeView<typename S::Traits>{}, layout_.nodes, layout_.entries,
+                                              layout_.triangles)
+                                .end);
         std::vector<std::byte> host(layout_.bytes);
         pack_tree<typename S::Traits>(s.nodes(), s.entries(), s.triangle_array(), layout_, host.data());
         cuda_check(cudaMalloc(&tree_, layout_.bytes), "cudaMalloc (tree)");
@@ -51,6 +61,10 @@ public:
     CudaAccelerator& operator=(const CudaAccelerator&) = delete;
 
     AccelStats stats() const override { return stats_; }
+    DeviceCacheStats cache_stats() const override {
+        const std::lock_guard lock(cache_mutex_);
+        return cache_stats_;
+    }
 
     double intersect_resident(DeviceRayBatch& batch, TraversalCounters* counters) const override {
         StreamTimer timer(cudaStreamPerThread);
@@ -94,19 +108,33 @@ private:
                 TraversalCounters* counters) const {
         // The warps' fetch counter runs up to n plus 32 a warp, in 32 bits.
         if (n > (std::size_t{1} << 31)) throw Error("a device batch holds at most 2^31 rays");
+        DeviceCacheStats cache;
         S::with_kernel(traversal_, [&](auto kernel) {
-            launch_trace<typename S::Traits, decltype(kernel), kAny>(
-                static_cast<const std::byte*>(tree_), layout_, rays, hits, occluded, static_cast<std::uint32_t>(n),
-                device_.multiprocessors, stream, counters);
+            auto go = [&]<bool kShared>() {
+                launch_trace<typename S::Traits, decltype(kernel), kAny, kShared>(
+                    static_cast<const std::byte*>(tree_), layout_, rays, hits, occluded, static_cast<std::uint32_t>(n),
+                    device_.multiprocessors, stream, counters, memory_, &cache);
+            };
+            if (memory_.shared) go.template operator()<true>();
+            else go.template operator()<false>();
         });
+        if (memory_.shared) {
+            const std::lock_guard lock(cache_mutex_);
+            cache_stats_.node_cache += cache.node_cache;
+            cache_stats_.triangle_cache += cache.triangle_cache;
+            cache_stats_.blocks += cache.blocks;
+        }
     }
 
     std::string traversal_name_;
     typename S::Traversal traversal_;
+    DeviceMemoryConfig memory_;
     DeviceInfo device_;
     AccelStats stats_;
     PackedTree layout_;
     void* tree_ = nullptr;
+    mutable std::mutex cache_mutex_;
+    mutable DeviceCacheStats cache_stats_;
 };
 
 }  // namespace cellrt::detail
