@@ -261,8 +261,8 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
     const Run& first = runs[group.front()];
     const bool node = first.sweep == "node";
     auto layout = [&](std::size_t i) { return node ? runs[i].config.node_cache : runs[i].config.triangle_cache; };
-    // The model's cycles, or on the device the kernels' time.
-    auto cycles = [&](std::size_t i) {
+    // What a layout costs: the model's cycles, or on the device the kernels' time.
+    auto cost = [&](std::size_t i) {
         return results[i].kernel_seconds > 0.0 ? results[i].kernel_seconds : static_cast<double>(results[i].stats.cycles);
     };
     auto per_ray = [&](std::size_t i) {
@@ -272,8 +272,8 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
     const CacheLayout study = node ? study_node_layout(first.structure) : kStudyTriangleLayout;
     std::size_t best = group.front(), best_direct = group.front(), at_study = group.front();
     for (std::size_t i : group) {
-        if (cycles(i) < cycles(best)) best = i;
-        if (layout(i).ways == 1 && (layout(best_direct).ways != 1 || cycles(i) < cycles(best_direct))) best_direct = i;
+        if (cost(i) < cost(best)) best = i;
+        if (layout(i).ways == 1 && (layout(best_direct).ways != 1 || cost(i) < cost(best_direct))) best_direct = i;
         if (layout(i) == study) at_study = i;
     }
     auto cell = [&](std::size_t i) {
@@ -288,7 +288,7 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
     std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.2f |\n", scene.c_str(),
                   first.structure.c_str(), first.traversal.c_str(), to_string(first.config.access),
                   node ? "nodes" : "triangles", cell(best).c_str(), cell(best_direct).c_str(), cell(at_study).c_str(),
-                  cycles(at_study) / cycles(best));
+                  cost(at_study) / cost(best));
     return buf;
 }
 

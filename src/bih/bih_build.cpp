@@ -443,8 +443,8 @@ private:
             return bins;
         }
         std::vector<Bins> blocks((items.size() + kBlock - 1) / kBlock);
-        tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
-            blocks[b].add(items.subspan(b * kBlock, std::min(kBlock, items.size() - b * kBlock)), origin, scale);
+        for_blocks(items.size(), [&](std::size_t begin, std::size_t end) {
+            blocks[begin / kBlock].add(items.subspan(begin, end - begin), origin, scale);
         });
         for (const Bins& block : blocks) bins.append(block);
         return bins;
