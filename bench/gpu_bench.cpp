@@ -1,12 +1,15 @@
 // The CUDA backend against Embree on all of the host's cores, on the same rays (docs/GPU.md): a
 // frame's primary rays and the rays its shading casts (shadow, AO, diffuse bounce; workload.hpp) at
 // --size, for every device configuration; rays resident on the device (the kernel's own time, CUDA
-// events) and, separately, host batches with their copies in and out. Every answer is compared with
-// the host's exact one. Without a device it says so in one line and exits with status 3.
+// events) and, separately, host batches with their copies in and out; and the frame path, the whole
+// frame made, traced and shaded on the device (render --device cuda), against cellrt's renderer on the
+// host's cores. Every answer is compared with the host's exact one, every pixel with the host's image.
+// Without a device it says so in one line and exits with status 3.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <thread>
 
@@ -17,6 +20,7 @@
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
+#include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "core/timer.hpp"
 #include "cellrt/workload.hpp"
@@ -92,7 +96,8 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
     Set sets[2] = {{"primary", f.primary, true, {}}, {to_string(f.secondary_kind), f.secondary, closest_hit(f.secondary_kind), {}}};
     for (Set& s : sets) trace_host(*exact, s.rays, s.closest, threads, s.exact);
     std::printf("\n### %s, %s rays, %dx%d: %zu primary + %zu %s\n\n| config | primary Grays/s | %s Grays/s | "
-                "with copies Grays/s | answers ≠ exact |\n|---|---|---|---|---|\n",
+                "with copies Grays/s | answers ≠ exact | frame: kernel, Grays/s, × CPU frame | pixels ≠ CPU |\n"
+                "|---|---|---|---|---|---|---|\n",
                 scene.name.c_str(), kind.c_str(), w, h, f.primary.size(), f.secondary.size(), sets[1].name,
                 sets[1].name);
     nlohmann::json row = {{"scene", scene.name}, {"rays", kind}, {"width", w}, {"height", h},
@@ -109,6 +114,22 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
                                   {"grays_per_s", s.rays.size() / median(t) * 1e-9}, {"differing", differing(a, s.exact)}};
         }
     }
+    // The whole frame on the host's cores through cellrt's renderer (the exact configuration): the
+    // image the device's frame path must give, and its time.
+    RenderOptions ro;
+    ro.width = w;
+    ro.height = h;
+    ro.threads = threads;
+    ro.shading = shading;
+    Image cpu_image;
+    std::vector<double> cpu_frame;
+    for (int k = 0; k < std::min(o.repeats, 3); ++k) {
+        RenderStats rs;
+        render(scene, *exact, ro, cpu_image, &rs);
+        cpu_frame.push_back(rs.seconds);
+    }
+    row["cpu_frame"] = {{"config", exact_config.kind + "+auto"}, {"seconds", median(cpu_frame)}};
+    const FrameShading frame = frame_shading(scene, PinholeCamera(scene.camera, w, h), shading);
     for (const std::string& spec : o.configs) {
         AccelConfig c = parse_accel_config(spec);
         const auto gpu_accel = make_device_accelerator(scene.triangles, c);
@@ -147,6 +168,29 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
                          {"differing", differing(a, s.exact) + differing(resident, s.exact)}};
             if (row.contains("cpu")) r[s.name]["times_cpu"] = row["cpu"][s.name]["seconds"].get<double>() / median(kernel);
         }
+        {
+            // The frame path: every pixel made, traced and shaded on the device (render --device cuda).
+            std::vector<Vec3> pixels(cpu_image.pixels.size());
+            std::vector<double> kernel, whole;
+            std::uint64_t frame_rays = 0;
+            for (int k = 0; k <= o.repeats; ++k) {  // the first pass warms up
+                TraversalCounters p, sec;
+                const auto t = gpu_accel->render_frame(scene.triangles, frame, 0, 0, w, h, pixels, p, sec);
+                frame_rays = p.rays + sec.rays;
+                if (k == 0) continue;
+                kernel.push_back(t.kernel_seconds);
+                whole.push_back(t.seconds);
+            }
+            std::size_t differ = 0;
+            for (std::size_t i = 0; i < pixels.size(); ++i)
+                differ += std::memcmp(&pixels[i], &cpu_image.pixels[i], sizeof(Vec3)) != 0;
+            r["frame"] = {{"kernel_seconds", median(kernel)},
+                          {"with_copies_seconds", median(whole)},
+                          {"rays", frame_rays},
+                          {"grays_per_s", static_cast<double>(frame_rays) / median(kernel) * 1e-9},
+                          {"times_cpu_frame", median(cpu_frame) / median(kernel)},
+                          {"differing_pixels", differ}};
+        }
         if (const DeviceCacheStats cs = gpu_accel->cache_stats(); cs.blocks > 0) {
             auto counts = [](const DeviceCacheCounts& c) {
                 return nlohmann::json{{"hits", c.hits},           {"misses", c.misses}, {"evictions", c.evictions},
@@ -161,10 +205,13 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
                                   {"node_cache", counts(cs.node_cache)},
                                   {"triangle_cache", counts(cs.triangle_cache)}};
         }
-        std::printf("| %s | %.3f | %.3f | %.3f / %.3f | %zu |\n", spec.c_str(), r["primary"]["grays_per_s"].get<double>(),
-                    r[sets[1].name]["grays_per_s"].get<double>(), r["primary"]["with_copies_grays_per_s"].get<double>(),
+        std::printf("| %s | %.3f | %.3f | %.3f / %.3f | %zu | %.2f ms, %.3f, %.1fx | %zu |\n", spec.c_str(),
+                    r["primary"]["grays_per_s"].get<double>(), r[sets[1].name]["grays_per_s"].get<double>(),
+                    r["primary"]["with_copies_grays_per_s"].get<double>(),
                     r[sets[1].name]["with_copies_grays_per_s"].get<double>(),
-                    r["primary"]["differing"].get<std::size_t>() + r[sets[1].name]["differing"].get<std::size_t>());
+                    r["primary"]["differing"].get<std::size_t>() + r[sets[1].name]["differing"].get<std::size_t>(),
+                    1e3 * r["frame"]["kernel_seconds"].get<double>(), r["frame"]["grays_per_s"].get<double>(),
+                    r["frame"]["times_cpu_frame"].get<double>(), r["frame"]["differing_pixels"].get<std::size_t>());
         row["gpu"].push_back(r);
     }
     out.push_back(row);

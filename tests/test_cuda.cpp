@@ -20,6 +20,8 @@
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
+#include "cellrt/render.hpp"
+#include "cellrt/workload.hpp"
 #include "error_of.hpp"
 #include "ray_suite.hpp"
 #include "structure_cases.hpp"
@@ -328,6 +330,94 @@ TEST(CudaRender, SameImageAsTheCpu) {
         }
     }
     fs::remove_all(dir);
+}
+
+// The frame path through the library: on every scene of the structure tests, both trees and both
+// memory modes, the three shadings, whole frames and a window of one (a distributed frame's tile) are
+// the CPU renderer's pixels bit for bit, with as many rays.
+TEST(CudaFrame, SameImageAndRaysAsTheCpuOnEveryScene) {
+    REQUIRE_GPU();
+    for (const std::string& name : test::structure_scene_names()) {
+        const Scene* scene = test::structure_scene(name);
+        if (!scene) continue;
+        const auto cpu = make_accelerator(scene->triangles, parse_accel_config("kd"));
+        const PixelRect window{13, 9, 150, 101};
+        struct Expected {
+            RenderOptions options;
+            Image image, tile;
+            RenderStats stats;
+        };
+        std::vector<Expected> expected;
+        for (const ShadingOptions shading : {ShadingOptions{Shading::direct, 4}, ShadingOptions{Shading::ao, 5},
+                                             ShadingOptions{Shading::diffuse, 4}}) {
+            Expected e;
+            e.options.width = 203;
+            e.options.height = 117;
+            e.options.shading = shading;
+            render(*scene, *cpu, e.options, e.image, &e.stats);
+            render_window(*scene, *cpu, e.options, window, e.tile);
+            expected.push_back(std::move(e));
+        }
+        for (const std::string spec : {"kd:branched", "bih:branchless", "kd:rec@memory=shared", "bih:branched@memory=shared"}) {
+            const auto gpu = make_accelerator(scene->triangles, cuda_config(spec));
+            for (const Expected& e : expected) {
+                const std::string what = spec + ", " + to_string(e.options.shading.shading) + " on " + name;
+                RenderStats stats;
+                const Image image = render(*scene, *gpu, e.options, &stats);
+                ASSERT_EQ(image.pixels.size(), e.image.pixels.size()) << what;
+                EXPECT_EQ(std::memcmp(image.pixels.data(), e.image.pixels.data(), image.pixels.size() * sizeof(Vec3)), 0)
+                    << what;
+                EXPECT_EQ(stats.primary_rays, e.stats.primary_rays) << what;
+                EXPECT_EQ(stats.secondary_rays, e.stats.secondary_rays) << what;
+                Image tile;
+                render_window(*scene, *gpu, e.options, window, tile);
+                ASSERT_EQ(tile.pixels.size(), e.tile.pixels.size()) << what;
+                EXPECT_EQ(std::memcmp(tile.pixels.data(), e.tile.pixels.data(), tile.pixels.size() * sizeof(Vec3)), 0)
+                    << what << ", window";
+            }
+        }
+    }
+}
+
+// The work a frame's rays do on the device is the host's for the same kernel: counted in the
+// renderer's statistics when asked.
+TEST(CudaFrame, CountsTheHostsWork) {
+    REQUIRE_GPU();
+    const Scene& scene = test::cached_scene("builtin:city?tris=20000");
+    RenderOptions ro;
+    ro.width = 96;
+    ro.height = 64;
+    ro.count = true;
+    ro.shading.shading = Shading::diffuse;
+    AccelConfig host = parse_accel_config("bih:branched");
+    host.simd = "off";
+    RenderStats cpu_stats, gpu_stats;
+    render(scene, *make_accelerator(scene.triangles, host), ro, &cpu_stats);
+    render(scene, *make_accelerator(scene.triangles, cuda_config("bih:branched")), ro, &gpu_stats);
+    EXPECT_EQ(gpu_stats.primary.rays, cpu_stats.primary.rays);
+    EXPECT_EQ(gpu_stats.primary.nodes, cpu_stats.primary.nodes);
+    EXPECT_EQ(gpu_stats.primary.triangles, cpu_stats.primary.triangles);
+    EXPECT_EQ(gpu_stats.secondary.rays, cpu_stats.secondary.rays);
+    EXPECT_EQ(gpu_stats.secondary.nodes, cpu_stats.secondary.nodes);
+    EXPECT_EQ(gpu_stats.secondary.triangles, cpu_stats.secondary.triangles);
+}
+
+// What the device accelerator's frame call refuses, in one line each.
+TEST(CudaFrame, RefusesAWindowOrTrianglesThatDoNotFit) {
+    REQUIRE_GPU();
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=2000");
+    const auto gpu = make_device_accelerator(scene.triangles, cuda_config("kd"));
+    const FrameShading frame = frame_shading(scene, PinholeCamera(scene.camera, 16, 16), {});
+    std::vector<Vec3> pixels(16 * 16);
+    TraversalCounters p, s;
+    EXPECT_EQ(test::error_of([&] { gpu->render_frame(scene.triangles, frame, 0, 0, 0, 16, pixels, p, s); }),
+              "device frame: the window 0x16 at (0, 0) is empty");
+    EXPECT_EQ(test::error_of([&] { gpu->render_frame(scene.triangles, frame, 0, 0, 16, 8, pixels, p, s); }),
+              "device frame: 256 pixels given for the window 16x8 at (0, 0)");
+    EXPECT_EQ(test::error_of([&] {
+                  gpu->render_frame(std::span(scene.triangles).first(10), frame, 0, 0, 16, 16, pixels, p, s);
+              }),
+              "device frame: 10 triangles given for a tree built over " + std::to_string(scene.triangles.size()));
 }
 
 }  // namespace

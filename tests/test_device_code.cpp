@@ -5,6 +5,7 @@
 // without CUDA and a GPU: CI has neither (docs/GPU.md).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -13,6 +14,10 @@
 
 #include "accel/structures.hpp"
 #include "cellrt/accel.hpp"
+#include "cellrt/camera.hpp"
+#include "cellrt/render.hpp"
+#include "cellrt/workload.hpp"
+#include "cuda/device_frame.hpp"
 #include "cuda/device_memory.hpp"
 #include "cuda/device_trace.hpp"
 #include "cuda/device_tree.hpp"
@@ -30,6 +35,10 @@ namespace {
 class CacheTracer : public Accelerator {
 public:
     virtual DeviceCacheStats caches() const = 0;  // mode (b): the caches' counts over every call so far
+    // The GPU frame path's threads, one pixel after another: the window's pixels, row-major, with
+    // the work of the primary rays and of every other ray added to the two counters.
+    virtual void render(const FrameShading& frame, std::span<const Triangle> triangles, const detail::FrameWindow& window,
+                        std::span<Vec3> pixels, TraversalCounters& primary, TraversalCounters& secondary) const = 0;
 };
 
 template <class S, class Kernel>
@@ -47,6 +56,19 @@ public:
     DeviceCacheStats caches() const override {
         const std::lock_guard lock(mutex_);
         return cache_stats_;
+    }
+
+    void render(const FrameShading& frame, std::span<const Triangle> triangles, const detail::FrameWindow& window,
+                std::span<Vec3> pixels, TraversalCounters& primary, TraversalCounters& secondary) const override {
+        with_memory([&](const auto& view, auto& mem) {
+            detail::PixelCounters c;
+            for (int y = 0; y < window.height; ++y)
+                for (int x = 0; x < window.width; ++x)
+                    pixels[static_cast<std::size_t>(y * window.width + x)] = detail::render_pixel<Traits, Kernel>(
+                        view, mem, frame, triangles.data(), window.x0 + x, window.y0 + y, c);
+            add(c.primary, static_cast<std::size_t>(window.width * window.height), &primary);
+            add(c.secondary, c.secondary_rays, &secondary);
+        });
     }
 
 private:
@@ -208,6 +230,78 @@ TEST_P(DeviceCodeSharedCaches, SameHitsAndWorkAsTheHost) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, DeviceCodeSharedCaches, testing::ValuesIn(test::structure_scene_names()),
+                         [](const auto& info) { return test::test_name(info.param); });
+
+class DeviceFrame : public testing::TestWithParam<std::string> {};
+
+// The GPU's frame path as each of its threads runs it (cuda/device_frame.hpp: a pixel's rays made,
+// traced through the packed tree and shaded), pixel after pixel on the host, gives the CPU renderer's
+// image bit for bit, for every tree and traversal, in both memory modes, under the three shadings,
+// for the whole frame and for a window of it (a distributed frame's tile); and it casts as many rays
+// as the renderer. The frame's sides are no multiple of the packets' or the GPU's 8 x 4 tiles.
+TEST_P(DeviceFrame, SameImageAsTheRenderer) {
+    const Scene* scene = test::structure_scene(GetParam());
+    if (!scene) GTEST_SKIP() << "scene " << GetParam() << " not found under " << test::scenes_dir();
+    constexpr int kWidth = 45, kHeight = 38;
+    const PixelRect window{7, 5, 30, 28};
+    const auto cpu = make_accelerator(scene->triangles, parse_accel_config("kd"));
+    struct Expected {
+        ShadingOptions shading;
+        Image image;
+        std::uint64_t secondary_rays;
+    };
+    std::vector<Expected> expected;
+    for (const ShadingOptions shading : {ShadingOptions{Shading::direct, 4}, ShadingOptions{Shading::ao, 3},
+                                         ShadingOptions{Shading::diffuse, 4}}) {
+        RenderOptions ro;
+        ro.width = kWidth;
+        ro.height = kHeight;
+        ro.threads = 2;
+        ro.packet = 8;
+        ro.shading = shading;
+        RenderStats stats;
+        Image image = cellrt::render(*scene, *cpu, ro, &stats);
+        expected.push_back({shading, std::move(image), stats.secondary_rays});
+    }
+    const PinholeCamera camera(scene->camera, kWidth, kHeight);
+    const auto same_bits = [](const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    for (const detail::DeviceMemoryConfig& memory : {detail::DeviceMemoryConfig{}, small_shared_caches()})
+        for_every_device_kernel(
+            scene->triangles,
+            [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
+                const auto& device = dynamic_cast<const CacheTracer&>(tracer);
+                for (const Expected& e : expected) {
+                    const std::string what = name + (memory.shared ? " (shared caches), " : ", ") +
+                                             to_string(e.shading.shading) + " on " + GetParam();
+                    const FrameShading frame = frame_shading(*scene, camera, e.shading);
+                    std::vector<Vec3> pixels(static_cast<std::size_t>(kWidth * kHeight));
+                    TraversalCounters primary, secondary;
+                    device.render(frame, scene->triangles, {0, 0, kWidth, kHeight}, pixels, primary, secondary);
+                    int differ = 0;
+                    for (int y = 0; y < kHeight; ++y)
+                        for (int x = 0; x < kWidth; ++x)
+                            differ += !same_bits(pixels[static_cast<std::size_t>(y * kWidth + x)], e.image.at(x, y));
+                    EXPECT_EQ(differ, 0) << what;
+                    EXPECT_EQ(primary.rays, static_cast<std::uint64_t>(kWidth * kHeight)) << what;
+                    EXPECT_EQ(secondary.rays, e.secondary_rays) << what;
+                    EXPECT_GT(secondary.rays, 0u) << what;
+
+                    std::vector<Vec3> tile(static_cast<std::size_t>(window.pixels()));
+                    TraversalCounters unused_primary, unused_secondary;
+                    device.render(frame, scene->triangles, {window.x0, window.y0, window.width(), window.height()}, tile,
+                                  unused_primary, unused_secondary);
+                    differ = 0;
+                    for (int y = 0; y < window.height(); ++y)
+                        for (int x = 0; x < window.width(); ++x)
+                            differ += !same_bits(tile[static_cast<std::size_t>(y * window.width() + x)],
+                                                 e.image.at(window.x0 + x, window.y0 + y));
+                    EXPECT_EQ(differ, 0) << what << ", window";
+                }
+            },
+            memory);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, DeviceFrame, testing::ValuesIn(test::structure_scene_names()),
                          [](const auto& info) { return test::test_name(info.param); });
 
 TEST(DeviceCodeDegenerate, SameHitsAsBruteForce) {

@@ -3,6 +3,7 @@
 
 #include "cellrt/ray.hpp"
 #include "cellrt/scene.hpp"
+#include "cellrt/shading.hpp"
 
 namespace cellrt {
 
@@ -13,22 +14,15 @@ public:
     PinholeCamera(const Camera& camera, int width, int height);
 
     // Ray through the centre of pixel (px, py); py = 0 is the top row. Direction is normalised.
-    Ray primary(int px, int py) const {
-        const float sx = (2.f * (static_cast<float>(px) + 0.5f) / width_ - 1.f) * half_w_;
-        const float sy = (1.f - 2.f * (static_cast<float>(py) + 0.5f) / height_) * half_h_;
-        Ray r;
-        r.org = origin_;
-        r.dir = normalize(forward_ + right_ * sx + up_ * sy);
-        return r;
-    }
+    Ray primary(int px, int py) const { return projection_.primary(px, py); }
 
-    int width() const { return static_cast<int>(width_); }
-    int height() const { return static_cast<int>(height_); }
+    int width() const { return static_cast<int>(projection_.width); }
+    int height() const { return static_cast<int>(projection_.height); }
+    // The checked camera as plain data (shading.hpp), for the GPU's frame path.
+    const PinholeProjection& projection() const { return projection_; }
 
 private:
-    Vec3 origin_, forward_, right_, up_;
-    float half_w_ = 0.f, half_h_ = 0.f;
-    float width_ = 1.f, height_ = 1.f;
+    PinholeProjection projection_;
 };
 
 }  // namespace cellrt

@@ -13,6 +13,8 @@
 
 #include "cellrt/accelerator.hpp"
 #include "cellrt/ray.hpp"
+#include "cellrt/shading.hpp"
+#include "cellrt/triangle.hpp"
 
 namespace cellrt {
 
@@ -88,6 +90,22 @@ public:
     virtual double occluded_resident(DeviceRayBatch& batch, TraversalCounters* counters = nullptr) const = 0;
     // Memory mode (b)'s cache counts over every call so far, host and resident batches alike.
     virtual DeviceCacheStats cache_stats() const = 0;
+
+    // The frame path (docs/GPU.md): the pixels [x0, x0 + width) x [y0, y0 + height) of the frame that
+    // `frame` describes, made on the device, each pixel's rays made, traced and shaded by one thread
+    // (shading.hpp's shade_pixel, the CPU renderer's colours bit for bit), into `pixels` (width x
+    // height, row-major). `triangles` are the scene's, those the tree was built over (a hit names
+    // one); they are copied in for the call, the pixels out. Adds the primary rays' work to `primary`
+    // and every other ray's to `secondary`. Thread-safe as intersect() is. Throws cellrt::Error for
+    // an empty window, a pixel count that does not match, triangles that are not the tree's, or a
+    // CUDA failure.
+    struct FrameResult {
+        double kernel_seconds = 0.0;  // the kernel's own time (CUDA events): no copies
+        double seconds = 0.0;         // the whole call: triangles in, kernel, pixels out
+    };
+    virtual FrameResult render_frame(std::span<const Triangle> triangles, const FrameShading& frame, int x0, int y0,
+                                     int width, int height, std::span<Vec3> pixels, TraversalCounters& primary,
+                                     TraversalCounters& secondary) const = 0;
 };
 
 }  // namespace cellrt

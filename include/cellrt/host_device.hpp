@@ -9,3 +9,11 @@
 #else
 #define CELLRT_HD
 #endif
+
+// CELLRT_NOINLINE keeps a device function a call (nvcc inlines device functions by default); on the
+// host it changes nothing.
+#if defined(__CUDA_ARCH__)
+#define CELLRT_NOINLINE __noinline__
+#else
+#define CELLRT_NOINLINE
+#endif

@@ -12,6 +12,7 @@
 #include "cellrt/image.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/schedule.hpp"
+#include "cellrt/shading.hpp"
 #include "cellrt/workload.hpp"
 
 namespace cellrt {
@@ -76,24 +77,8 @@ public:
 
 private:
     struct State;
+    void render_on_device(const PixelRect& window, Image& tile, RenderStats* stats);
     std::unique_ptr<State> state_;
 };
-
-// The point a hit names and the triangle's geometric normal there, turned to face the side the ray
-// came from.
-struct SurfacePoint {
-    Vec3 position, normal;
-};
-SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit);
-
-// Shadow-ray origin for a hit point p on a surface with geometric normal n (facing the side the
-// ray came from): p pushed off the surface by a few ulps of its own magnitude, so the ray cannot
-// hit the surface it starts on (Wächter & Binder, "A Fast and Robust Method for Avoiding
-// Self-Intersection", Ray Tracing Gems, ch. 6).
-Vec3 offset_ray_origin(const Vec3& p, const Vec3& n);
-
-// The renderer's shadow ray from hit point p with viewer-facing normal n toward a point light:
-// origin offset_ray_origin(p, n), unit direction, tnear 0, tfar just short of the light.
-Ray shadow_ray(const Vec3& p, const Vec3& n, const Vec3& light);
 
 }  // namespace cellrt

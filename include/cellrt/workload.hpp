@@ -22,23 +22,21 @@
 #include "cellrt/camera.hpp"
 #include "cellrt/scene.hpp"
 #include "cellrt/schedule.hpp"
+#include "cellrt/shading.hpp"
 
 namespace cellrt {
 
-enum class Shading : std::uint8_t { direct, ao, diffuse };
 Shading parse_shading(const std::string& name);  // "direct" | "ao" | "diffuse"; throws cellrt::Error
 const char* to_string(Shading s);
 std::vector<std::string> shading_names();
 
-inline constexpr int kMaxAoSamples = 64;
-
-struct ShadingOptions {
-    Shading shading = Shading::direct;
-    int ao_samples = 4;  // AO rays per primary hit, 1..kMaxAoSamples
-};
-
-// The AO rays' reach: this fraction of the scene box's diagonal.
-inline constexpr float kAoReachFraction = 0.1f;
+// Throws cellrt::Error for AO samples outside [1, kMaxAoSamples].
+void check_shading(const ShadingOptions& shading);
+// The reach of the AO rays in `scene`: kAoReachFraction of its box's diagonal.
+float ao_reach(const Scene& scene);
+// What shade_pixel (shading.hpp) needs of a frame of `scene` seen through `camera`: the GPU's frame
+// path. Throws as check_shading does.
+FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading);
 
 // The kinds of rays a packet casts. Primary and bounce rays ask for the closest hit, the others for
 // any hit.

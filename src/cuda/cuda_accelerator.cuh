@@ -10,6 +10,7 @@
 #include <cuda_runtime.h>
 
 #include <mutex>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,8 @@ public:
         : traversal_name_(choose_traversal(names_of(S::kTraversals), config.traversal, S::kName)),
           traversal_(value_named(S::kTraversals, traversal_name_, "traversal")),
           memory_(read_device_memory(config)),
-          device_(require_cuda_device()) {
+          device_(require_cuda_device()),
+          scene_triangles_(triangles.size()) {
         Timer timer;
         const S s(triangles, without_device_memory(config));
         stats_.build_seconds = timer.seconds();
@@ -78,6 +80,43 @@ public:
         return timer.seconds();
     }
 
+    FrameResult render_frame(std::span<const Triangle> triangles, const FrameShading& frame, int x0, int y0, int width,
+                             int height, std::span<Vec3> pixels, TraversalCounters& primary,
+                             TraversalCounters& secondary) const override {
+        const std::string window = std::to_string(width) + "x" + std::to_string(height) + " at (" + std::to_string(x0) +
+                                   ", " + std::to_string(y0) + ")";
+        if (width < 1 || height < 1) throw Error("device frame: the window " + window + " is empty");
+        const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+        if (pixels.size() != n)
+            throw Error("device frame: " + std::to_string(pixels.size()) + " pixels given for the window " + window);
+        if (triangles.size() != scene_triangles_)
+            throw Error("device frame: " + std::to_string(triangles.size()) + " triangles given for a tree built over " +
+                        std::to_string(scene_triangles_));
+        Timer wall;
+        const cudaStream_t stream = cudaStreamPerThread;
+        const std::size_t pixels_at = align_up(triangles.size_bytes(), kPackedAlignment);
+        StreamBuffer buffer(pixels_at + pixels.size_bytes(), stream);
+        if (!triangles.empty())
+            cuda_check(cudaMemcpyAsync(buffer.at<Triangle>(0), triangles.data(), triangles.size_bytes(),
+                                       cudaMemcpyHostToDevice, stream),
+                       "cudaMemcpyAsync (triangles)");
+        FrameResult result;
+        StreamTimer timer(stream);
+        dispatch([&](auto kernel, auto shared, DeviceCacheStats& cache) {
+            launch_frame<typename S::Traits, decltype(kernel), decltype(shared)::value>(
+                static_cast<const std::byte*>(tree_), layout_, buffer.at<Triangle>(0), frame,
+                FrameWindow{x0, y0, width, height}, buffer.at<Vec3>(pixels_at), device_.multiprocessors, stream, memory_,
+                primary, secondary, &cache);
+        });
+        result.kernel_seconds = timer.seconds();
+        cuda_check(cudaMemcpyAsync(pixels.data(), buffer.at<Vec3>(pixels_at), pixels.size_bytes(),
+                                   cudaMemcpyDeviceToHost, stream),
+                   "cudaMemcpyAsync (pixels)");
+        cuda_check(cudaStreamSynchronize(stream), "frame");
+        result.seconds = wall.seconds();
+        return result;
+    }
+
 private:
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
         host_batch<false>(rays, hits.data(), hits.size_bytes(), counters);
@@ -108,15 +147,21 @@ private:
                 TraversalCounters* counters) const {
         // The warps' fetch counter runs up to n plus 32 a warp, in 32 bits.
         if (n > (std::size_t{1} << 31)) throw Error("a device batch holds at most 2^31 rays");
+        dispatch([&](auto kernel, auto shared, DeviceCacheStats& cache) {
+            launch_trace<typename S::Traits, decltype(kernel), kAny, decltype(shared)::value>(
+                static_cast<const std::byte*>(tree_), layout_, rays, hits, occluded, static_cast<std::uint32_t>(n),
+                device_.multiprocessors, stream, counters, memory_, &cache);
+        });
+    }
+
+    // Calls go(kernel, std::bool_constant<shared>, cache) with the chosen traversal's kernel and memory
+    // mode, then adds the launch's cache counts (mode (b)) to the accelerator's.
+    template <class Go>
+    void dispatch(Go&& go) const {
         DeviceCacheStats cache;
         S::with_kernel(traversal_, [&](auto kernel) {
-            auto go = [&]<bool kShared>() {
-                launch_trace<typename S::Traits, decltype(kernel), kAny, kShared>(
-                    static_cast<const std::byte*>(tree_), layout_, rays, hits, occluded, static_cast<std::uint32_t>(n),
-                    device_.multiprocessors, stream, counters, memory_, &cache);
-            };
-            if (memory_.shared) go.template operator()<true>();
-            else go.template operator()<false>();
+            if (memory_.shared) go(kernel, std::true_type{}, cache);
+            else go(kernel, std::false_type{}, cache);
         });
         if (memory_.shared) {
             const std::lock_guard lock(cache_mutex_);
@@ -130,6 +175,7 @@ private:
     typename S::Traversal traversal_;
     DeviceMemoryConfig memory_;
     DeviceInfo device_;
+    std::size_t scene_triangles_;  // the triangles the tree was built over: a frame's hits name them
     AccelStats stats_;
     PackedTree layout_;
     void* tree_ = nullptr;

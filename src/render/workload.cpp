@@ -18,26 +18,32 @@ constexpr detail::Named<RayKind> kRayKindNames[] = {{"primary", RayKind::primary
                                                     {"bounce", RayKind::bounce},
                                                     {"bounce shadow", RayKind::bounce_shadow}};
 
-// The random numbers of a pixel: sample s of the AO rays uses dimensions 0 and 1, the bounce
-// dimensions 2 and 3, so no two rays of a pixel share a number.
-constexpr std::uint32_t kAoDims = 0, kBounceDims = 2;
-
-// A ray leaving the surface point `sp` in the cosine-weighted direction drawn for (pixel, sample,
-// dims), reaching `tfar`; its origin is pushed off the surface as a shadow ray's is.
-Ray hemisphere_ray(const SurfacePoint& sp, std::uint64_t pixel, std::uint32_t sample, std::uint32_t dims, float tfar) {
-    Ray r;
-    r.org = offset_ray_origin(sp.position, sp.normal);
-    r.dir = cosine_hemisphere(sp.normal, hash_uniform(pixel, sample, dims), hash_uniform(pixel, sample, dims + 1));
-    r.tfar = tfar;
-    return r;
-}
-
 }  // namespace
 
 Shading parse_shading(const std::string& name) { return detail::value_named(kShadings, name, "shading"); }
 const char* to_string(Shading s) { return detail::name_of(kShadings, s); }
 std::vector<std::string> shading_names() { return detail::names_of(kShadings); }
 const char* to_string(RayKind k) { return detail::name_of(kRayKindNames, k); }
+
+void check_shading(const ShadingOptions& shading) {
+    if (shading.ao_samples < 1 || shading.ao_samples > kMaxAoSamples)
+        throw Error("AO samples " + std::to_string(shading.ao_samples) + " must lie in [1, " +
+                    std::to_string(kMaxAoSamples) + "]");
+}
+
+float ao_reach(const Scene& scene) { return kAoReachFraction * length(scene.bounds().extent()); }
+
+FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading) {
+    check_shading(shading);
+    FrameShading f;
+    f.camera = camera.projection();
+    f.light_position = scene.light.position;
+    f.light_color = scene.light.color;
+    f.shading = shading;
+    f.ao_reach = ao_reach(scene);
+    f.frame_width = camera.width();
+    return f;
+}
 
 RayKind secondary_kind(Shading s) {
     switch (s) {
@@ -103,10 +109,8 @@ struct alignas(kCacheLine) PacketWorkload::Buffers {
 PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
                                const ShadingOptions& shading)
     : scene_(&scene), camera_(&camera), shading_(shading), buffers_(std::make_unique<Buffers>()) {
-    if (shading.ao_samples < 1 || shading.ao_samples > kMaxAoSamples)
-        throw Error("AO samples " + std::to_string(shading.ao_samples) + " must lie in [1, " +
-                    std::to_string(kMaxAoSamples) + "]");
-    ao_reach_ = kAoReachFraction * length(scene.bounds().extent());
+    check_shading(shading);
+    ao_reach_ = ao_reach(scene);
     Buffers& b = *buffers_;
     b.order.reserve(max_pixels);
     b.pixel.reserve(max_pixels);

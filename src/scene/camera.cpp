@@ -17,17 +17,18 @@ PinholeCamera::PinholeCamera(const Camera& camera, int width, int height) {
     const Vec3 view = camera.look_at - camera.position;
     if (!(length(view) > 0.f)) throw Error("camera look_at equals position: the view direction has zero length");
     if (!(length(camera.up) > 0.f)) throw Error("camera up has zero length");
-    forward_ = normalize(view);
-    const Vec3 side = cross(forward_, camera.up);
+    PinholeProjection& p = projection_;
+    p.forward = normalize(view);
+    const Vec3 side = cross(p.forward, camera.up);
     // sin of the angle between up and the view direction; below ~1e-4 rad the basis is meaningless.
     if (!(length(side) > 1e-4f * length(camera.up))) throw Error("camera up is parallel to the view direction");
-    right_ = normalize(side);
-    up_ = cross(right_, forward_);
-    origin_ = camera.position;
-    half_h_ = std::tan(0.5f * camera.fov_y_deg * std::numbers::pi_v<float> / 180.f);
-    half_w_ = half_h_ * static_cast<float>(width) / static_cast<float>(height);
-    width_ = static_cast<float>(width);
-    height_ = static_cast<float>(height);
+    p.right = normalize(side);
+    p.up = cross(p.right, p.forward);
+    p.origin = camera.position;
+    p.half_h = std::tan(0.5f * camera.fov_y_deg * std::numbers::pi_v<float> / 180.f);
+    p.half_w = p.half_h * static_cast<float>(width) / static_cast<float>(height);
+    p.width = static_cast<float>(width);
+    p.height = static_cast<float>(height);
 }
 
 }  // namespace cellrt

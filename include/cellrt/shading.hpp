@@ -1,0 +1,217 @@
+// The renderer's rules for one pixel, in one source for the CPU and the GPU (CELLRT_HD): the camera's
+// primary ray, the rays a shading casts from a hit (shadow, AO, diffuse bounce) and the colour their
+// answers give. The CPU's frame workload (workload.hpp) makes its batches with these functions and
+// shades with them (render.cpp); the GPU frame path runs shade_pixel() in each thread
+// (cuda/device_frame.hpp). Every step is a +, -, *, /, sqrt or an integer operation, compiled with no
+// contraction on both sides (docs/GPU.md), so a pixel's colour is the same bits wherever it is made.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+
+#include "cellrt/host_device.hpp"
+#include "cellrt/ray.hpp"
+#include "cellrt/sampling.hpp"
+#include "cellrt/triangle.hpp"
+#include "cellrt/vec.hpp"
+
+namespace cellrt {
+
+enum class Shading : std::uint8_t { direct, ao, diffuse };
+
+inline constexpr int kMaxAoSamples = 64;
+
+struct ShadingOptions {
+    Shading shading = Shading::direct;
+    int ao_samples = 4;  // AO rays per primary hit, 1..kMaxAoSamples
+};
+
+// The AO rays' reach: this fraction of the scene box's diagonal.
+inline constexpr float kAoReachFraction = 0.1f;
+
+// The random numbers of a pixel: sample s of the AO rays uses dimensions 0 and 1, the bounce
+// dimensions 2 and 3, so no two rays of a pixel share a number.
+inline constexpr std::uint32_t kAoDims = 0, kBounceDims = 2;
+
+// A pinhole camera's rays: one through the centre of each pixel (camera.hpp's PinholeCamera checks
+// the camera and fills this). Plain data, copied to the GPU as it is.
+struct PinholeProjection {
+    Vec3 origin, forward, right, up;
+    float half_w = 0.f, half_h = 0.f;
+    float width = 1.f, height = 1.f;
+
+    // The ray through the centre of pixel (px, py); py = 0 is the top row. Direction is normalised.
+    CELLRT_HD Ray primary(int px, int py) const {
+        const float sx = (2.f * (static_cast<float>(px) + 0.5f) / width - 1.f) * half_w;
+        const float sy = (1.f - 2.f * (static_cast<float>(py) + 0.5f) / height) * half_h;
+        Ray r;
+        r.org = origin;
+        r.dir = normalize(forward + right * sx + up * sy);
+        return r;
+    }
+};
+
+// The point a hit names and the triangle's geometric normal there, turned to face the side the ray
+// came from.
+struct SurfacePoint {
+    Vec3 position, normal;
+};
+
+CELLRT_HD inline SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit) {
+    Vec3 n = normalize(tri.geometric_normal());
+    if (dot(n, ray.dir) > 0.f) n = -n;
+    return {tri.v0 * (1.f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v, n};
+}
+
+namespace detail {
+CELLRT_HD inline std::int32_t float_bits(float f) {
+#if defined(__CUDA_ARCH__)
+    return __float_as_int(f);
+#else
+    return std::bit_cast<std::int32_t>(f);
+#endif
+}
+CELLRT_HD inline float bits_float(std::int32_t i) {
+#if defined(__CUDA_ARCH__)
+    return __int_as_float(i);
+#else
+    return std::bit_cast<float>(i);
+#endif
+}
+}  // namespace detail
+
+// Shadow-ray origin for a hit point p on a surface with geometric normal n (facing the side the
+// ray came from): p pushed off the surface by a few ulps of its own magnitude, so the ray cannot
+// hit the surface it starts on (Wächter & Binder, "A Fast and Robust Method for Avoiding
+// Self-Intersection", Ray Tracing Gems, ch. 6). Far from the origin it moves by a fixed number of
+// ulps (an integer offset on the float bits), which scales with |p|; near the origin, where ulps are
+// tiny, by a small absolute amount.
+CELLRT_HD inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
+    constexpr float kNearOrigin = 1.f / 32.f, kFloatScale = 1.f / 65536.f, kIntScale = 256.f;
+    Vec3 out;
+    for (int a = 0; a < 3; ++a) {
+        const auto ulps = static_cast<std::int32_t>(kIntScale * n[a]);
+        const std::int32_t bits = detail::float_bits(p[a]) + (p[a] < 0.f ? -ulps : ulps);
+        out[a] = std::fabs(p[a]) < kNearOrigin ? p[a] + kFloatScale * n[a] : detail::bits_float(bits);
+    }
+    return out;
+}
+
+// The renderer's shadow ray from hit point p with viewer-facing normal n toward a point light:
+// origin offset_ray_origin(p, n), unit direction, tnear 0, tfar just short of the light.
+CELLRT_HD inline Ray shadow_ray(const Vec3& p, const Vec3& n, const Vec3& light) {
+    Ray s;
+    s.org = offset_ray_origin(p, n);
+    const Vec3 to_light = light - s.org;
+    const float dist = length(to_light);
+    s.dir = to_light * (1.f / dist);
+    s.tnear = 0.f;
+    s.tfar = dist * 0.9999f;  // stop just short of the light itself
+    return s;
+}
+
+// A ray leaving the surface point `sp` in the cosine-weighted direction drawn for (pixel, sample,
+// dims), reaching `tfar`; its origin is pushed off the surface as a shadow ray's is.
+CELLRT_HD inline Ray hemisphere_ray(const SurfacePoint& sp, std::uint64_t pixel, std::uint32_t sample,
+                                    std::uint32_t dims, float tfar) {
+    Ray r;
+    r.org = offset_ray_origin(sp.position, sp.normal);
+    r.dir = cosine_hemisphere(sp.normal, hash_uniform(pixel, sample, dims), hash_uniform(pixel, sample, dims + 1));
+    r.tfar = tfar;
+    return r;
+}
+
+// The colours. Each pixel's colour is a sum in a fixed order of terms that hits decide, so it is the
+// same bits under every structure, traversal, packet size, thread count and device.
+namespace shade {
+
+// Every surface's colour (a function: a constant of class type is not visible to device code).
+CELLRT_HD constexpr Vec3 albedo() { return {0.8f, 0.78f, 0.74f}; }
+inline constexpr float kAmbient = 0.12f;
+
+// What a ray that escapes sees.
+CELLRT_HD inline Vec3 sky(const Vec3& dir) {
+    const float k = 0.5f * (dir.y + 1.f);
+    return Vec3{0.9f, 0.95f, 1.f} * (1.f - k) + Vec3{0.35f, 0.55f, 0.9f} * k;
+}
+
+// Lambert's cosine at the start of a shadow ray (unit direction `dir`, from a surface of normal
+// `normal`), 0 where something blocks the light.
+CELLRT_HD inline float lambert(bool occluded, const Vec3& normal, const Vec3& dir) {
+    return occluded ? 0.f : std::max(0.f, dot(normal, dir));
+}
+
+// `direct`, the study's: Lambert under the point light and a little ambient light.
+CELLRT_HD inline Vec3 direct(float lambert_cos, const Vec3& light_color) {
+    return albedo() * (kAmbient + lambert_cos) * light_color;
+}
+
+// `ao`: the fraction of the hit's `samples` AO rays that escape.
+CELLRT_HD inline Vec3 ambient_occlusion(int open, int samples) {
+    return albedo() * (static_cast<float>(open) / static_cast<float>(samples));
+}
+
+// `diffuse`: with cosine-weighted bounces the estimate of the light a bounce brings is what arrives
+// along it (the cosine and the density cancel): the sky where it escapes, or the direct light at its
+// hit (bounce_light).
+CELLRT_HD inline Vec3 bounce_light(float lambert_cos, const Vec3& light_color) {
+    return albedo() * light_color * lambert_cos;
+}
+CELLRT_HD inline Vec3 diffuse(float lambert_cos, const Vec3& light_color, const Vec3& incoming) {
+    return albedo() * (light_color * lambert_cos + incoming);
+}
+
+}  // namespace shade
+
+// What shade_pixel() needs of a frame besides the triangles and the tree: plain data for the GPU.
+struct FrameShading {
+    PinholeProjection camera;
+    Vec3 light_position, light_color;
+    ShadingOptions shading;
+    float ao_reach = 0.f;  // kAoReachFraction of the scene box's diagonal
+    int frame_width = 0;   // pixel (x, y) seeds its random numbers with y * frame_width + x
+};
+
+// The colour of pixel (x, y): its primary ray, the rays its shading casts, in the CPU's order, and the
+// colour of render.cpp. closest(ray, primary) returns a ray's hit under the hit rule (primary: the
+// camera's ray, else a bounce); any(ray) whether anything blocks it. `triangles` are the scene's,
+// which a hit's index names.
+template <class Closest, class Any>
+CELLRT_HD Vec3 shade_pixel(const FrameShading& f, const Triangle* triangles, int x, int y, Closest&& closest,
+                           Any&& any) {
+    const Ray primary = f.camera.primary(x, y);
+    const Hit hit = closest(primary, true);
+    if (!hit.is_hit()) return shade::sky(primary.dir);
+    const SurfacePoint sp = surface_point(triangles[hit.prim], primary, hit);
+    const std::uint64_t pixel =
+        static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(f.frame_width) + static_cast<std::uint64_t>(x);
+    switch (f.shading.shading) {
+        case Shading::ao: {
+            int open = 0;
+            for (int s = 0; s < f.shading.ao_samples; ++s)
+                open += any(hemisphere_ray(sp, pixel, static_cast<std::uint32_t>(s), kAoDims, f.ao_reach)) ? 0 : 1;
+            return shade::ambient_occlusion(open, f.shading.ao_samples);
+        }
+        case Shading::diffuse: {
+            const Ray shadow = shadow_ray(sp.position, sp.normal, f.light_position);
+            const float direct = shade::lambert(any(shadow), sp.normal, shadow.dir);
+            const Ray bounce = hemisphere_ray(sp, pixel, 0, kBounceDims, kInfinity);
+            const Hit bounce_hit = closest(bounce, false);
+            Vec3 incoming = shade::sky(bounce.dir);
+            if (bounce_hit.is_hit()) {
+                const SurfacePoint bp = surface_point(triangles[bounce_hit.prim], bounce, bounce_hit);
+                const Ray bounce_shadow = shadow_ray(bp.position, bp.normal, f.light_position);
+                incoming = shade::bounce_light(shade::lambert(any(bounce_shadow), bp.normal, bounce_shadow.dir),
+                                               f.light_color);
+            }
+            return shade::diffuse(direct, f.light_color, incoming);
+        }
+        case Shading::direct: break;
+    }
+    const Ray shadow = shadow_ray(sp.position, sp.normal, f.light_position);
+    return shade::direct(shade::lambert(any(shadow), sp.normal, shadow.dir), f.light_color);
+}
+
+}  // namespace cellrt
