@@ -13,7 +13,8 @@
 // threads.
 //
 // With --device cuda the same runs go to the GPU's memory mode (b) instead (docs/GPU.md): the study's
-// caches in each block's shared memory, of the run's layouts, synchronous access only. The frame's
+// caches in each block's shared memory, of the run's layouts and access (async: cp.async as the touch,
+// the next read as the wait, with its re-touch). The frame's
 // sampled rays are copied to the device once, each run's tree is built and copied there, and its
 // primary and shadow rays are traced as two resident batches, one ray per thread. The CSV keeps its
 // columns: hits and misses are the blocks' lookups summed (a torn read counts as a miss), bytes the
@@ -118,17 +119,20 @@ struct DeviceFrame {
 };
 
 // The device's counts as the model's: a torn read went to global memory, so it is a miss; the bytes
-// moved are the lines filled (a miss that found its slot being filled read global memory alone).
+// moved are the lines filled, by misses and by touches (a miss that found its slot being filled read
+// global memory alone).
 CacheStats model_counts(const DeviceCacheCounts& d, std::uint32_t line_bytes) {
     CacheStats c;
     c.hits = d.hits;
     c.misses = d.misses + d.torn;
+    c.prefetches = d.prefetches;
+    c.touch_hits = d.touch_hits;
     c.evictions = d.evictions;
-    c.bytes = (d.misses - d.unfilled) * std::uint64_t{line_bytes};
+    c.bytes = (d.misses - d.unfilled + d.prefetches) * std::uint64_t{line_bytes};
     return c;
 }
 
-// One run on the GPU, memory mode (b) with the run's layouts (synchronous: `access` is sync).
+// One run on the GPU, memory mode (b) with the run's layouts and access.
 Result trace_device(const Scene& scene, const Run& run, const FrameRays& w, DeviceFrame& frame) {
     AccelConfig c;
     c.kind = run.structure;
@@ -136,6 +140,7 @@ Result trace_device(const Scene& scene, const Run& run, const FrameRays& w, Devi
     c.device = "cuda";
     const CacheLayout &n = run.config.node_cache, &t = run.config.triangle_cache;
     c.params = {{"memory", "shared"},
+                {"access", to_string(run.config.access)},
                 {"node_line", std::to_string(n.line_bytes)},
                 {"node_sets", std::to_string(n.sets)},
                 {"node_ways", std::to_string(n.ways)},
@@ -330,16 +335,16 @@ Runner add_cache_study(CLI::App& app) {
     cmd->add_option("--threads", o->threads, "Runs traced at once (0: all cores)")->capture_default_str();
     cmd->add_option("--structures", o->structures, "Structures: kd, bih")->capture_default_str();
     cmd->add_option("--traversals", o->traversals, "Traversals: branched, branchless")->capture_default_str();
-    auto* access = cmd->add_option("--access", o->access, "Cache access modes: sync, async")->capture_default_str();
+    cmd->add_option("--access", o->access, "Cache access modes: sync, async")->capture_default_str();
     cmd->add_option("--device", o->device,
                     "cpu: the local-store model (modelled cycles); cuda: the GPU's software caches in shared "
-                    "memory (memory mode (b), measured kernel time; sync access only)")
+                    "memory (memory mode (b), measured kernel time)")
         ->capture_default_str();
     cmd->add_option("--sweeps", o->sweeps, "Caches swept: node (Graphs 5-1..5-6), triangle (5-7..5-10)")
         ->capture_default_str();
     cmd->add_flag("--overwrite", o->overwrite, "Replace existing output files");
     cluster::add_sweep_options(*cmd);
-    return [o, access] {
+    return [o] {
         // Under MPI each step runs on every rank, a step that fails on one fails on all, and the runs
         // are shared among the ranks (cluster.hpp); rank 0 alone prints and writes.
         std::string csv_path, md_path;
@@ -349,11 +354,6 @@ Runner add_cache_study(CLI::App& app) {
             checked_choices("--access", o->access, {"sync", "async"});
             checked_choices("--device", {o->device}, {"cpu", "cuda"});
             if (o->device == "cuda") {
-                // Mode (b) reads synchronously (no cp.async touch yet): the default list shrinks to it,
-                // an explicit async is refused.
-                if (access->count() == 0) o->access = {"sync"};
-                else if (std::find(o->access.begin(), o->access.end(), "async") != o->access.end())
-                    throw Error("--access async: the GPU's shared-memory caches read synchronously (docs/GPU.md)");
                 if (cluster::ranks() > 1)
                     throw Error("--device cuda runs in one process (one GPU); run it without mpirun");
                 const DeviceInfo gpu = cuda_device_info();

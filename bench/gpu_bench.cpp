@@ -34,10 +34,17 @@ struct Options {
     std::string scenes_dir = "../shared/scenes";
     std::vector<std::string> scenes{"sponza", "sibenik", "bunny", "builtin:city"};
     std::vector<std::string> rays{"frame", "ao", "diffuse"};
-    // The last two: memory mode (b), the study's caches in shared memory (its default layouts).
-    std::vector<std::string> configs{"kd:branched", "kd:branchless", "kd:rec", "bih:branched", "bih:branchless",
-                                     "bih:branched@split=sah", "kd:branched@memory=shared",
-                                     "bih:branched@memory=shared"};
+    // The last three: memory mode (b), the study's caches in shared memory (its default layouts),
+    // synchronous, and the kd-tree's with asynchronous access too.
+    std::vector<std::string> configs{"kd:branched",
+                                     "kd:branchless",
+                                     "kd:rec",
+                                     "bih:branched",
+                                     "bih:branchless",
+                                     "bih:branched@split=sah",
+                                     "kd:branched@memory=shared",
+                                     "bih:branched@memory=shared",
+                                     "kd:branched@memory=shared,access=async"};
     std::string cpu_config = "embree";
     std::string size = "1920x1080", json_path;
     int repeats = 5, ao_samples = 4;
@@ -193,8 +200,13 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
         }
         if (const DeviceCacheStats cs = gpu_accel->cache_stats(); cs.blocks > 0) {
             auto counts = [](const DeviceCacheCounts& c) {
-                return nlohmann::json{{"hits", c.hits},           {"misses", c.misses}, {"evictions", c.evictions},
-                                      {"torn", c.torn},           {"unfilled", c.unfilled},
+                return nlohmann::json{{"hits", c.hits},
+                                      {"misses", c.misses},
+                                      {"evictions", c.evictions},
+                                      {"torn", c.torn},
+                                      {"unfilled", c.unfilled},
+                                      {"prefetches", c.prefetches},
+                                      {"touch_hits", c.touch_hits},
                                       {"hit_ratio", c.lookups() ? double(c.hits) / double(c.lookups()) : 0.0}};
             };
             // Over every launch of this configuration on this scene, all ray sets together.

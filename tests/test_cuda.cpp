@@ -121,28 +121,29 @@ TEST(CudaRefusals, SharedMemoryLayouts) {
 TEST(CudaRefusals, CacheStudyOnTheDevice) {
     const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
     const std::string study = "cache-study builtin:spheres?tris=200 --size 16x16 -o " + dir.string() + " --device ";
-    const auto [async, async_status] = run_cli(study + "cuda --access async");
-    EXPECT_EQ(async_status, 1) << async;
-    EXPECT_EQ(async, "cellrt: error: --access async: the GPU's shared-memory caches read synchronously (docs/GPU.md)\n");
     const auto [other, other_status] = run_cli(study + "tpu");
     EXPECT_EQ(other_status, 1) << other;
     EXPECT_EQ(other, "cellrt: error: --device 'tpu' is not one of: cpu, cuda\n");
-    if (!have_gpu()) {
-        const auto [out, status] = run_cli(study + "cuda");
-        EXPECT_EQ(status, 1) << out;
-        EXPECT_EQ(out, "cellrt: error: --device cuda: no device (" + cuda_device_info().reason + ")\n");
-    }
+    const auto [bad, bad_status] = run_cli(study + "cuda --access dma");
+    EXPECT_EQ(bad_status, 1) << bad;
+    EXPECT_NE(bad.find("--access"), std::string::npos) << bad;
+    if (!have_gpu())
+        for (const char* access : {"", " --access async"}) {
+            const auto [out, status] = run_cli(study + "cuda" + access);
+            EXPECT_EQ(status, 1) << out;
+            EXPECT_EQ(out, "cellrt: error: --device cuda: no device (" + cuda_device_info().reason + ")\n");
+        }
     EXPECT_FALSE(fs::exists(dir));
 }
 
 // The study's sweeps on the GPU: one CSV row per run, as the model writes, each run's lookups those of
-// the model's run with the same layouts (a read's lookups depend on its address and size only), its
-// time measured (frame_ms) and none modelled (cycles 0).
+// the model's run with the same layouts and access (a read's lookups depend on its address and size
+// only; touches are counted apart), its time measured (frame_ms) and none modelled (cycles 0).
 TEST(CudaCacheStudy, SameRunsAndLookupsAsTheModel) {
     REQUIRE_GPU();
     const fs::path dir = fs::temp_directory_path() / ("cellrt_cuda_study_" + std::to_string(::getpid()));
     const std::string study = "cache-study builtin:spheres?tris=2000 --size 64x64 --sample 1 --structures kd bih "
-                              "--traversals branched --access sync --overwrite -o ";
+                              "--traversals branched --access sync async --overwrite -o ";
     for (const char* device : {"cpu", "cuda"}) {
         const auto [out, status] = run_cli(study + (dir / device).string() + " --device " + device);
         ASSERT_EQ(status, 0) << out;
@@ -167,7 +168,7 @@ TEST(CudaCacheStudy, SameRunsAndLookupsAsTheModel) {
         return row[static_cast<std::size_t>(std::find(h.begin(), h.end(), column) - h.begin())];
     };
     for (std::size_t i = 1; i < gpu.size(); ++i) {
-        for (const char* same : {"structure", "sweep", "node_layout", "tri_layout", "rays"})
+        for (const char* same : {"structure", "access", "sweep", "node_layout", "tri_layout", "rays"})
             EXPECT_EQ(at(gpu[i], same), at(cpu[i], same)) << "row " << i << " " << same;
         for (const char* cache : {"node", "tri"}) {
             const std::string c(cache);
@@ -264,11 +265,13 @@ TEST(CudaSharedMemory, SameHitsAndLookupsAsTheModel) {
     const Scene& scene = test::cached_scene(name);
     const test::ReferenceAnswers& ref = test::cached_reference(name, scene.triangles);
     for (const std::string& spec : kCudaConfigs) {
-        for (const char* ways : {"1", "4"}) {
+        for (const auto& [ways, access] : {std::pair{"1", "sync"}, std::pair{"4", "sync"}, std::pair{"1", "async"},
+                                           std::pair{"4", "async"}}) {
             AccelConfig c = cuda_config(spec);
-            c.params.insert({{"memory", "shared"}, {"node_line", "64"}, {"node_sets", "64"}, {"node_ways", ways},
-                             {"triangle_line", "128"}, {"triangle_sets", "32"}, {"triangle_ways", ways}});
-            const std::string what = "cuda " + spec + " memory=shared ways " + ways;
+            c.params.insert({{"memory", "shared"}, {"access", access}, {"node_line", "64"}, {"node_sets", "64"},
+                             {"node_ways", ways}, {"triangle_line", "128"}, {"triangle_sets", "32"},
+                             {"triangle_ways", ways}});
+            const std::string what = "cuda " + spec + " memory=shared ways " + ways + " access " + access;
             const auto device = make_device_accelerator(scene.triangles, c);
             test::expect_matches(*device, ref, what);
             const DeviceCacheStats before = device->cache_stats();
@@ -290,6 +293,11 @@ TEST(CudaSharedMemory, SameHitsAndLookupsAsTheModel) {
                 << what;
             EXPECT_GT(s.node_cache.hits, 0u) << what;
             EXPECT_GT(s.blocks, before.blocks) << what;
+            if (access == std::string("async")) {
+                EXPECT_GT(s.node_cache.prefetches, 0u) << what;
+            } else {
+                EXPECT_EQ(s.node_cache.prefetches + s.node_cache.touch_hits, 0u) << what;
+            }
             const auto& settings = device->stats().settings;
             EXPECT_TRUE(std::any_of(settings.begin(), settings.end(), [](const auto& kv) {
                 return kv.first == "memory" && kv.second.rfind("shared: ", 0) == 0;

@@ -108,7 +108,7 @@ private:
         triangles.clear(0, 1);
         const detail::CacheAddressMap map =
             detail::cache_address_map(view, layout_.nodes, layout_.entries, layout_.triangles);
-        detail::SharedCacheMemory<typename Traits::Node> mem(nodes, triangles, map);
+        detail::SharedCacheMemory<typename Traits::Node> mem(nodes, triangles, map, memory_.async);
         fn(view, mem);
         const std::lock_guard lock(mutex_);
         cache_stats_.node_cache += mem.node_counts;
@@ -184,10 +184,12 @@ INSTANTIATE_TEST_SUITE_P(Scenes, DeviceCode, testing::ValuesIn(test::structure_s
                          [](const auto& info) { return test::test_name(info.param); });
 
 // Memory mode (b) on the host: small caches, so that lines are evicted all the time and objects
-// straddle lines (12-byte BIH nodes in 32-byte lines, 36-byte triangles in 64-byte ones).
-detail::DeviceMemoryConfig small_shared_caches() {
+// straddle lines (12-byte BIH nodes in 32-byte lines, 36-byte triangles in 64-byte ones); with
+// `async`, the study's asynchronous access (touch, then wait).
+detail::DeviceMemoryConfig small_shared_caches(bool async = false) {
     detail::DeviceMemoryConfig m;
     m.shared = true;
+    m.async = async;
     m.node_cache = {32, 64, 4};
     m.triangle_cache = {64, 32, 1};
     return m;
@@ -265,13 +267,16 @@ TEST_P(DeviceFrame, SameImageAsTheRenderer) {
     }
     const PinholeCamera camera(scene->camera, kWidth, kHeight);
     const auto same_bits = [](const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
-    for (const detail::DeviceMemoryConfig& memory : {detail::DeviceMemoryConfig{}, small_shared_caches()})
+    for (const detail::DeviceMemoryConfig& memory :
+         {detail::DeviceMemoryConfig{}, small_shared_caches(), small_shared_caches(true)})
         for_every_device_kernel(
             scene->triangles,
             [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
                 const auto& device = dynamic_cast<const CacheTracer&>(tracer);
                 for (const Expected& e : expected) {
-                    const std::string what = name + (memory.shared ? " (shared caches), " : ", ") +
+                    const std::string what = name + (memory.shared ? memory.async ? " (shared caches, async), "
+                                                                                  : " (shared caches), "
+                                                                   : ", ") +
                                              to_string(e.shading.shading) + " on " + GetParam();
                     const FrameShading frame = frame_shading(*scene, camera, e.shading);
                     std::vector<Vec3> pixels(static_cast<std::size_t>(kWidth * kHeight));
@@ -310,12 +315,14 @@ TEST(DeviceCodeDegenerate, SameHitsAsBruteForce) {
         for_every_device_kernel(tris, [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
             test::expect_matches(tracer, ref, "device code " + name + " on " + what);
         });
-        for_every_device_kernel(
-            tris,
-            [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
-                test::expect_matches(tracer, ref, "shared-memory caches " + name + " on " + what);
-            },
-            small_shared_caches());
+        for (const bool async : {false, true})
+            for_every_device_kernel(
+                tris,
+                [&](const std::string& name, const Accelerator& tracer, const HostPath&) {
+                    test::expect_matches(tracer, ref,
+                                         "shared-memory caches " + name + (async ? " async" : "") + " on " + what);
+                },
+                small_shared_caches(async));
     }
 }
 

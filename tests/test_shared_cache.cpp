@@ -42,6 +42,8 @@ void expect_same_counts(const CacheStats& model, const DeviceCacheCounts& shared
     EXPECT_EQ(shared.hits, model.hits) << what;
     EXPECT_EQ(shared.misses, model.misses) << what;
     EXPECT_EQ(shared.evictions, model.evictions) << what;
+    EXPECT_EQ(shared.prefetches, model.prefetches) << what;
+    EXPECT_EQ(shared.touch_hits, model.touch_hits) << what;
     EXPECT_EQ(shared.torn + shared.unfilled, 0u) << what;
 }
 
@@ -98,15 +100,21 @@ TEST(SharedCache, SameCountsAndBytesAsTheLocalStoresCacheForOneStream) {
     });
 }
 
+// An address map with `words` as its node array at 4096 and the other two arrays empty.
+CacheAddressMap nodes_only(const std::vector<std::uint32_t>& words) {
+    CacheAddressMap map{};
+    map.data[0] = map.data[1] = map.data[2] = reinterpret_cast<const std::byte*>(words.data());
+    for (int r = 0; r < 3; ++r) {
+        map.base[r] = r == 0 ? 4096 : 1u << 30;
+        map.bytes[r] = r == 0 ? words.size() * 4 : 0;
+    }
+    return map;
+}
+
 // Worked by hand: one set of four 16-byte ways, least recently used replacement.
 TEST(SharedCache, FourWayLruByHand) {
     const std::vector<std::uint32_t> bytes(1024, 0x5a5a5a5a);
-    CacheAddressMap map{};
-    map.data[0] = map.data[1] = map.data[2] = reinterpret_cast<const std::byte*>(bytes.data());
-    for (int r = 0; r < 3; ++r) {
-        map.base[r] = r == 0 ? 4096 : 1u << 30;
-        map.bytes[r] = r == 0 ? bytes.size() * 4 : 0;
-    }
+    const CacheAddressMap map = nodes_only(bytes);
     HostCache c({16, 1, 4});  // one set of 4 ways
     DeviceCacheCounts n;
     std::uint32_t out[4];
@@ -132,12 +140,7 @@ TEST(SharedCache, FourWayLruByHand) {
 TEST(SharedCache, ALineBeingFilledIsReadFromGlobalMemory) {
     std::vector<std::uint32_t> bytes(64);
     for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = 1000 + static_cast<std::uint32_t>(i);
-    CacheAddressMap map{};
-    map.data[0] = map.data[1] = map.data[2] = reinterpret_cast<const std::byte*>(bytes.data());
-    for (int r = 0; r < 3; ++r) {
-        map.base[r] = r == 0 ? 4096 : 1u << 30;
-        map.bytes[r] = r == 0 ? bytes.size() * 4 : 0;
-    }
+    const CacheAddressMap map = nodes_only(bytes);
     const SharedCacheLayout layout{16, 4, 1};
     HostCache c(layout);
     // The directory follows the lines: tags, then sequence numbers (shared_cache.hpp).
@@ -161,10 +164,49 @@ TEST(SharedCache, ALineBeingFilledIsReadFromGlobalMemory) {
     EXPECT_EQ(n.torn, 0u);
 }
 
-// Whole traversals: one worker of the model (synchronous access) and the policy of mode (b) on the
-// host, tracing the same rays in the same order over the same tree, count the same hits, misses and
-// evictions in the node cache (nodes and leaf entries) and in the triangle cache, for every tree and
-// traversal: the GPU's caches, one thread at a time, are the study's.
+// Asynchronous access by hand: a touch claims the line's slot and starts its copy, which stays odd
+// (in flight) and unread until the toucher's wait; meanwhile another thread's read does not trust the
+// slot and reads global memory; the wait publishes the line, whose bytes the next read finds; and a
+// touch of a line already there is a touch hit.
+TEST(SharedCache, ATouchedLineIsInFlightUntilTheWait) {
+    std::vector<std::uint32_t> bytes(64);
+    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = 2000 + static_cast<std::uint32_t>(i);
+    const CacheAddressMap map = nodes_only(bytes);
+    const SharedCacheLayout layout{32, 4, 1};
+    HostCache c(layout);
+    const std::uint32_t* line0 = c.words.data();
+    const std::uint32_t& seq0 = c.words[layout.lines() * layout.line_bytes / 4 + layout.lines()];
+    detail::AsyncFills fills;
+    DeviceCacheCounts mine, other;
+    c.cache.touch(map, 4096 + 16, 24, fills, mine);  // lines 0 and 1: two prefetches
+    EXPECT_EQ(mine.prefetches, 2u);
+    EXPECT_EQ(fills.count, 2);
+    EXPECT_EQ(seq0, 1u);
+    EXPECT_EQ(line0[2], 0u);  // not arrived: the host makes the copy at the wait
+    std::uint32_t out[2] = {};
+    c.cache.read(map, 4096 + 8, 8, out, other);  // another thread: the slot is in flight
+    EXPECT_EQ(other.hits, 0u);
+    EXPECT_EQ(other.unfilled, 1u);
+    EXPECT_EQ(out[0], 2002u);
+    c.cache.complete(map, fills);
+    EXPECT_EQ(fills.count, 0);
+    EXPECT_EQ(seq0, 2u);
+    EXPECT_EQ(line0[2], 2002u);
+    out[0] = out[1] = 0;
+    c.cache.read(map, 4096 + 40, 8, out, mine);  // line 1, published by the same wait
+    EXPECT_EQ(mine.hits, 1u);
+    EXPECT_EQ(out[1], 2011u);
+    c.cache.touch(map, 4096, 4, fills, mine);
+    EXPECT_EQ(mine.touch_hits, 1u);
+    EXPECT_EQ(fills.count, 0);
+    EXPECT_EQ(mine.misses + mine.evictions, 0u);
+}
+
+// Whole traversals: one worker of the model and the policy of mode (b) on the host, tracing the same
+// rays in the same order over the same tree, count the same hits, misses and evictions in the node
+// cache (nodes and leaf entries) and in the triangle cache, and with asynchronous access the same
+// prefetches and touch hits, for every tree and traversal: the GPU's caches, one thread at a time,
+// are the study's, in both access modes (the model's asynchronous access with its re-touch).
 TEST(SharedCache, SameCountsAsTheLocalStoreModelOverWholeTraversals) {
     const std::string name = "builtin:city?tris=20000";
     const Scene& scene = test::cached_scene(name);
@@ -178,11 +220,14 @@ TEST(SharedCache, SameCountsAsTheLocalStoreModelOverWholeTraversals) {
         const S s(scene.triangles, config);
         using Traits = typename S::Traits;
         for (const auto& t : S::kTraversals) {
-            for (const auto& [nodes, triangles] : layouts) {
-                const std::string what = std::string(S::kName) + ":" + t.name + " " + text(nodes) + " " + text(triangles);
+            for (const auto& [nodes, triangles] : layouts)
+              for (const CacheAccess access : {CacheAccess::sync, CacheAccess::async}) {
+                const std::string what = std::string(S::kName) + ":" + t.name + " " + text(nodes) + " " + text(triangles) +
+                                         " " + to_string(access);
                 LocalStoreConfig c;
                 c.node_cache = {nodes.line_bytes, nodes.sets, nodes.ways};
                 c.triangle_cache = {triangles.line_bytes, triangles.sets, triangles.ways};
+                c.access = access;
                 config.traversal = t.name;
                 const auto model = make_local_store_accelerator(scene.triangles, config, c);
                 std::vector<Hit> want(rays.size()), got(rays.size());
@@ -193,7 +238,8 @@ TEST(SharedCache, SameCountsAsTheLocalStoreModelOverWholeTraversals) {
                 const auto view = s.view();
                 const CacheAddressMap map = detail::cache_address_map(view, s.nodes().size(), s.entries().size(),
                                                                       s.triangle_array().size());
-                detail::SharedCacheMemory<typename Traits::Node> mem(node_cache.cache, triangle_cache.cache, map);
+                detail::SharedCacheMemory<typename Traits::Node> mem(node_cache.cache, triangle_cache.cache, map,
+                                                                     access == CacheAccess::async);
                 detail::RayCounters count;
                 S::with_kernel(t.value, [&](auto kernel) {
                     for (std::size_t i = 0; i < rays.size(); ++i)
@@ -204,7 +250,10 @@ TEST(SharedCache, SameCountsAsTheLocalStoreModelOverWholeTraversals) {
                 expect_same_counts(m.triangle_cache, mem.triangle_counts, what + " triangle cache");
                 EXPECT_GT(mem.node_counts.evictions, 0u) << what;
                 EXPECT_GT(mem.triangle_counts.hits, 0u) << what;
-            }
+                if (access == CacheAccess::async) {
+                    EXPECT_GT(mem.node_counts.prefetches, 0u) << what;
+                }
+              }
         }
     });
 }
@@ -217,6 +266,11 @@ AccelConfig with_params(std::map<std::string, std::string> params) {
 
 TEST(DeviceMemoryParams, DefaultIsGlobalMemoryAndSharedTakesTheLayouts) {
     EXPECT_FALSE(detail::read_device_memory(AccelConfig{}).shared);
+    EXPECT_FALSE(detail::read_device_memory(with_params({{"memory", "shared"}})).async);
+    const detail::DeviceMemoryConfig a = detail::read_device_memory(with_params({{"memory", "shared"}, {"access", "async"}}));
+    EXPECT_TRUE(a.async);
+    EXPECT_EQ(a.to_string(), "shared: node cache 128x128, triangle cache 128x128, " + std::to_string(a.shared_bytes()) +
+                                 " B a block, asynchronous access");
     const detail::DeviceMemoryConfig m = detail::read_device_memory(with_params(
         {{"memory", "shared"}, {"node_line", "64"}, {"node_sets", "256"}, {"node_ways", "4"}, {"triangle_line", "32"}}));
     EXPECT_TRUE(m.shared);
@@ -249,6 +303,9 @@ TEST(DeviceMemoryParams, BadLayoutsAreRefusedInOneLine) {
     EXPECT_NE(error({{"memory", "texture"}}).find("memory"), std::string::npos);
     EXPECT_EQ(test::error_of([] { detail::read_device_memory(with_params({{"node_line", "64"}})); }),
               "cuda parameter node_line=64 shapes the shared-memory caches: it needs memory=shared");
+    EXPECT_EQ(test::error_of([] { detail::read_device_memory(with_params({{"access", "async"}})); }),
+              "cuda parameter access=async shapes the shared-memory caches: it needs memory=shared");
+    EXPECT_NE(error({{"access", "dma"}}).find("access"), std::string::npos);
 }
 
 TEST(DeviceMemoryParams, CachesOverTheBlocksSharedMemoryAreRefused) {

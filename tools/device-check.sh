@@ -8,8 +8,9 @@
 #
 # `run` writes $OUT/info.txt (`cellrt info --device cuda`), $OUT/gpu_tests.json (the GPU tests, GoogleTest's
 # JSON), $OUT/gpu_bench.json and .md (the GPU benchmark beside Embree on all host cores, same rays),
-# $OUT/cache_study/ (the study's cache sweeps in the GPU's shared memory, memory mode (b)), and
-# $OUT/scaling_pull_16core.json (the CPU scaling curve, docs/SCALING.md), each step under a time limit
+# $OUT/cache_study/ (the study's cache sweeps in the GPU's shared memory, memory mode (b), synchronous),
+# $OUT/scaling_pull_16core.json (the CPU scaling curve, docs/SCALING.md) and $OUT/cache_study_async/ (the
+# node cache's sweep with asynchronous access), each step under a time limit
 # of its own, and $OUT/summary.json with each step's exit status and seconds.
 # With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=560).
 set -euo pipefail
@@ -71,9 +72,13 @@ run)
     --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$out/gpu_bench.json"
   cp "$out/gpu_bench.log" "$out/gpu_bench.md"
   timed cache_study 75 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda --size 1920x1080 \
-    --sample 4 --structures kd bih --traversals branched -o "$out/cache_study"
+    --sample 4 --structures kd bih --traversals branched --access sync -o "$out/cache_study"
   timed scaling 100 "$run" cellrt_scaling --scenes-dir "$CELLRT_SCENES" --dispatch pull --packets 16 --repeats 3 \
     --workers 1 2 4 8 12 16 --configs embree:single kd+auto bih+auto --json "$out/scaling_pull_16core.json"
+  # Last, as the step a short call may cut: asynchronous access, whose touches reach the node cache only.
+  timed cache_study_async 45 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda \
+    --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access async --sweeps node \
+    -o "$out/cache_study_async"
   rm -rf "$CELLRT_TEST_CACHE"
   echo "  \"device\": true }" >> "$summary"
   ;;

@@ -66,12 +66,15 @@ private:
 // global memory because another thread of the block was filling the slot); a lookup that finds the
 // line but sees it replaced while copying it out reads global memory too and counts as `torn`, not
 // as a hit. Only concurrent threads make the last two: one thread a cache (the host's tests) never.
+// Asynchronous access counts its touches apart, as the model does: `prefetches` started a line's
+// fill, `touch_hits` found the line there.
 struct DeviceCacheCounts {
-    unsigned long long hits = 0, misses = 0, evictions = 0, torn = 0, unfilled = 0;
+    unsigned long long hits = 0, misses = 0, evictions = 0, torn = 0, unfilled = 0, prefetches = 0, touch_hits = 0;
 
     unsigned long long lookups() const { return hits + misses + torn; }
     DeviceCacheCounts& operator+=(const DeviceCacheCounts& o) {
         hits += o.hits; misses += o.misses; evictions += o.evictions; torn += o.torn; unfilled += o.unfilled;
+        prefetches += o.prefetches; touch_hits += o.touch_hits;
         return *this;
     }
 };

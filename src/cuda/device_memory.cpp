@@ -34,7 +34,7 @@ bool is_memory_param(const std::string& name) {
 std::string DeviceMemoryConfig::to_string() const {
     if (!shared) return "global";
     return "shared: node cache " + layout_text(node_cache) + ", triangle cache " + layout_text(triangle_cache) + ", " +
-           std::to_string(shared_bytes()) + " B a block";
+           std::to_string(shared_bytes()) + " B a block" + (async ? ", asynchronous access" : "");
 }
 
 const ParamTable& device_memory_params() {
@@ -42,7 +42,11 @@ const ParamTable& device_memory_params() {
     static const ParamTable table = [] {
         ParamTable t{{"memory", choice, "global", 0, 0, {"global", "shared"},
                       "CUDA: the tree in global memory through L1/L2 (global), or the study's software caches in "
-                      "each block's shared memory (shared)"}};
+                      "each block's shared memory (shared)"},
+                     {"access", choice, "sync", 0, 0, {"sync", "async"},
+                      "CUDA, memory=shared: node reads wait for their line (sync), or a node's child pair is "
+                      "touched when the node is read, its lines copied by cp.async until the next read waits "
+                      "(async; the study's section 4.3)"}};
         for (const char* cache : kCaches) {
             const std::string c = cache;
             t.push_back({c + "_line", integer, "128", 16, 4096, {},
@@ -64,6 +68,7 @@ DeviceMemoryConfig read_device_memory(const AccelConfig& config) {
     ParamReader in(device_memory_params(), mine, "cuda");
     DeviceMemoryConfig m;
     m.shared = in.choice("memory") == "shared";
+    m.async = in.choice("access") == "async";
     SharedCacheLayout* layouts[] = {&m.node_cache, &m.triangle_cache};
     for (int i = 0; i < 2; ++i) {
         const std::string c = kCaches[i];

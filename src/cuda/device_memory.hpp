@@ -16,16 +16,18 @@ namespace cellrt::detail {
 
 struct DeviceMemoryConfig {
     bool shared = false;                      // mode (b)
+    bool async = false;                       // mode (b): the study's asynchronous access (touch, then wait)
     SharedCacheLayout node_cache{128, 128, 1};  // the local-store model's default: the study's largest caches
     SharedCacheLayout triangle_cache{128, 128, 1};
 
     // Dynamic shared memory a block needs for both caches (mode (b)).
     std::size_t shared_bytes() const { return node_cache.bytes() + triangle_cache.bytes(); }
-    // "global", or "shared: node cache 128x128, triangle cache 64x64x4, 35328 B a block".
+    // "global", or "shared: node cache 128x128, triangle cache 64x64x4, 35328 B a block" (", asynchronous
+    // access" after it with `async`).
     std::string to_string() const;
 };
 
-// The parameters of the memory mode: memory, node_line, node_sets, node_ways, triangle_line, ...
+// The parameters of the memory mode: memory, access, node_line, node_sets, node_ways, triangle_line, ...
 const ParamTable& device_memory_params();
 
 // The memory mode `config.params` asks for. Throws cellrt::Error in one line for a value out of

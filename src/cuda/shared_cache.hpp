@@ -4,8 +4,11 @@
 // model's counts. A cache maps lines of the tree's address space (CacheAddressMap) by set (line
 // number mod sets) and tag, direct-mapped or in the least recently used of 4 ways, as the model does,
 // so that one thread reading one ray after another counts exactly the model's hits, misses and
-// evictions for the same reads (tests/test_shared_cache.cpp). Access is synchronous: a miss copies
-// its line in before the read returns (no cp.async touch yet).
+// evictions for the same reads (tests/test_shared_cache.cpp). Access is synchronous (a miss copies
+// its line in before the read returns) or asynchronous, the study's touch then wait (its section
+// 4.3): touch() claims the slots of a child pair's lines and starts their copies (`cp.async` on the
+// GPU, the SPE's DMA get), and the thread's next read first waits for them (complete()), looking the
+// line up again as it reads (the study's re-touch: the wait trusts no slot its touch chose).
 //
 // Sharing (the choice, and why). On the Cell a cache belonged to one SPE tracing one ray at a time;
 // on the GPU the 128 threads of a block share the block's caches, which is what makes them pay:
@@ -121,6 +124,29 @@ inline bool claim(std::uint32_t* seq, std::uint32_t even) {
 inline std::uint32_t tick(std::uint32_t* clock) { return ++*clock; }
 #endif
 
+// Asynchronous access: the line fills one thread has started and not yet waited for. On the GPU their
+// copies are the thread's cp.async groups; on the host they are made at the wait, so that a read that
+// did not wait would read the slot's old bytes (and fail the tests). A filling slot's sequence number
+// stays odd until the wait, so other threads never read it half-filled.
+struct AsyncFills {
+    static constexpr int kMax = 4;  // a child pair spans at most two lines
+    std::uint32_t slot[kMax];
+    std::uint32_t seq[kMax];   // the slot's even sequence number before the fill claimed it
+    std::uint64_t line[kMax];  // the line's address, for the host's copy
+    int count = 0;
+};
+
+#if defined(__CUDA_ARCH__)
+// Starts the copy of 16 bytes into shared memory, of which the first `from_bytes` (0 to 16) come from
+// `from` and the rest are zeros (cp.async's source size); cp.async.ca: through L1.
+__device__ inline void copy_16_async(std::uint32_t* to, const std::byte* from, std::uint32_t from_bytes) {
+    const auto shared = static_cast<std::uint32_t>(__cvta_generic_to_shared(to));
+    asm volatile("cp.async.ca.shared.global [%0], [%1], 16, %2;\n" ::"r"(shared), "l"(from), "r"(from_bytes) : "memory");
+}
+__device__ inline void commit_async() { asm volatile("cp.async.commit_group;\n" ::: "memory"); }
+__device__ inline void wait_async() { asm volatile("cp.async.wait_all;\n" ::: "memory"); }
+#endif
+
 // One software cache over `storage` (layout.bytes() bytes, 16-byte aligned). A view: copies share the cache.
 class SharedCache {
 public:
@@ -180,19 +206,84 @@ public:
         }
     }
 
+    // The asynchronous touch of [address, address + size) (within one array of `map`): a line in the
+    // cache counts a touch hit and is marked used; a missing one is placed as a miss would place it
+    // and its copy started (a prefetch), to complete at complete(fills). A slot another thread is
+    // filling is left to it (the touch is a hint; the read will look again). The thread's earlier
+    // fills are completed first, so a line is never in flight twice.
+    CELLRT_HD void touch(const CacheAddressMap& map, std::uint64_t address, std::uint32_t size, AsyncFills& fills,
+                         DeviceCacheCounts& c) const {
+        complete(map, fills);
+        const std::uint64_t end = address + size;
+        for (std::uint64_t line = address & ~std::uint64_t(line_bytes_ - 1); line < end; line += line_bytes_) {
+            const std::uint32_t tag = static_cast<std::uint32_t>(line >> line_shift_);
+            const std::uint32_t first = (tag & (sets_ - 1)) * ways_;
+            std::uint32_t s = first;
+            while (s < first + ways_ && ((shared_load(&seqs_[s]) & 1u) || shared_load(&tags_[s]) != tag)) ++s;
+            if (s < first + ways_) {
+                ++c.touch_hits;
+                stamps_[s] = tick(clock_);
+                continue;
+            }
+            if (fills.count == AsyncFills::kMax) complete(map, fills);
+            const std::uint32_t victim = victim_in(first);
+            const std::uint32_t seq = shared_load(&seqs_[victim]);
+            if ((seq & 1u) || !claim(&seqs_[victim], seq)) continue;
+            ++c.prefetches;
+            block_fence();
+            if (shared_load(&tags_[victim]) != kEmpty) ++c.evictions;
+            shared_store(&tags_[victim], tag);
+            stamps_[victim] = tick(clock_);
+#if defined(__CUDA_ARCH__)
+            const int region = map.region_of(line);
+            const std::uint64_t stop = map.base[region] + map.bytes[region];
+            const std::byte* from = map.at(region, line);
+            std::uint32_t* bytes = line_data(victim);
+            for (std::uint32_t k = 0; k < line_bytes_ / 16; ++k) {
+                const std::uint64_t at = line + 16 * k;
+                const std::uint32_t n = at >= stop ? 0u : stop - at >= 16 ? 16u : static_cast<std::uint32_t>(stop - at);
+                copy_16_async(bytes + 4 * k, n ? from + 16 * k : from, n);
+            }
+            commit_async();
+#endif
+            fills.slot[fills.count] = victim;
+            fills.seq[fills.count] = seq;
+            fills.line[fills.count] = line;
+            ++fills.count;
+        }
+    }
+
+    // The wait: the thread's started fills complete (their copies arrive; on the host, are made) and
+    // are published, their slots readable by every thread.
+    CELLRT_HD void complete(const CacheAddressMap& map, AsyncFills& fills) const {
+        if (fills.count == 0) return;
+#if defined(__CUDA_ARCH__)
+        static_cast<void>(map);
+        wait_async();
+#else
+        for (int k = 0; k < fills.count; ++k) copy_line(map, fills.line[k], line_data(fills.slot[k]));
+#endif
+        block_fence();
+        for (int k = 0; k < fills.count; ++k) shared_store(&seqs_[fills.slot[k]], fills.seq[k] + 2);
+        fills.count = 0;
+    }
+
 private:
-    // A miss: the line goes into an empty way of its set, else the least recently used one (the only
-    // one when direct-mapped), as SoftwareCache::place chooses.
-    CELLRT_HD void fill(const CacheAddressMap& map, std::uint64_t line, std::uint32_t tag, std::uint32_t first,
-                        std::uint64_t address, std::uint32_t size, std::uint32_t* words, DeviceCacheCounts& c) const {
+    // Where a missing line of the set starting at slot `first` goes: an empty way, else the least
+    // recently used one (the only one when direct-mapped), as SoftwareCache::place chooses.
+    CELLRT_HD std::uint32_t victim_in(std::uint32_t first) const {
         std::uint32_t victim = first;
         for (std::uint32_t s = first; s < first + ways_; ++s) {
-            if (shared_load(&tags_[s]) == kEmpty) {
-                victim = s;
-                break;
-            }
+            if (shared_load(&tags_[s]) == kEmpty) return s;
             if (stamps_[s] < stamps_[victim]) victim = s;
         }
+        return victim;
+    }
+
+    // A read's miss: the line is placed, filled at once, and the piece read from it.
+    CELLRT_HD void fill(const CacheAddressMap& map, std::uint64_t line, std::uint32_t tag, std::uint32_t first,
+                        std::uint64_t address, std::uint32_t size, std::uint32_t* words, DeviceCacheCounts& c) const {
+        const std::uint32_t victim = victim_in(first);
         const std::uint32_t seq = shared_load(&seqs_[victim]);
         if ((seq & 1u) || !claim(&seqs_[victim], seq)) {
             ++c.unfilled;
@@ -203,14 +294,19 @@ private:
         if (shared_load(&tags_[victim]) != kEmpty) ++c.evictions;
         shared_store(&tags_[victim], tag);
         std::uint32_t* bytes = line_data(victim);
-        const int region = map.region_of(line);
-        const std::uint64_t stop = map.base[region] + map.bytes[region];
-        const std::byte* from = map.at(region, line);
-        for (std::uint32_t w = 0; w < line_bytes_ / 4; ++w) bytes[w] = line + 4 * w < stop ? global_word(from + 4 * w) : 0u;
+        copy_line(map, line, bytes);
         copy_piece(bytes, line, address, size, words);
         stamps_[victim] = tick(clock_);
         block_fence();
         shared_store(&seqs_[victim], seq + 2);
+    }
+
+    // The line's bytes from the tree's arrays into `bytes`, zeros past its array's end.
+    CELLRT_HD void copy_line(const CacheAddressMap& map, std::uint64_t line, std::uint32_t* bytes) const {
+        const int region = map.region_of(line);
+        const std::uint64_t stop = map.base[region] + map.bytes[region];
+        const std::byte* from = map.at(region, line);
+        for (std::uint32_t w = 0; w < line_bytes_ / 4; ++w) bytes[w] = line + 4 * w < stop ? global_word(from + 4 * w) : 0u;
     }
 
     CELLRT_HD std::uint32_t* line_data(std::uint32_t slot) const { return data_ + std::size_t(slot) * (line_bytes_ / 4); }
@@ -241,24 +337,37 @@ private:
 
 // The memory policy of mode (b): DirectMemory's interface (kernel/traversal.hpp) through a node cache
 // (nodes and leaf entries, as the model's CachedMemory) and a triangle cache, so the trees' kernels
-// run through it unchanged. One per thread; the caches are the block's. Synchronous only:
-// touch_node() does nothing.
+// run through it unchanged. One per thread; the caches are the block's. Synchronous, or with `async`
+// the study's asynchronous access: touch_node() starts the fills of a child pair's lines as soon as
+// the kernel reads their parent, and the next read of the node cache waits for them (with its
+// re-touch: the line is looked up again).
 template <class Node>
 class SharedCacheMemory {
 public:
     CELLRT_HD SharedCacheMemory(const SharedCache& node_cache, const SharedCache& triangle_cache,
-                                const CacheAddressMap& map)
-        : node_cache_(node_cache), triangle_cache_(triangle_cache), map_(map) {}
+                                const CacheAddressMap& map, bool async = false)
+        : node_cache_(node_cache), triangle_cache_(triangle_cache), map_(map), async_(async) {}
+    // A fill still in flight is published before the thread leaves (another thread may want its slot).
+    CELLRT_HD ~SharedCacheMemory() { node_cache_.complete(map_, fills_); }
+    SharedCacheMemory(const SharedCacheMemory&) = delete;
+    SharedCacheMemory& operator=(const SharedCacheMemory&) = delete;
 
     CELLRT_HD const Node& node(std::uint32_t i) {
+        node_cache_.complete(map_, fills_);
         std::uint32_t words[sizeof(Node) / 4];
         node_cache_.read(map_, map_.base[CacheAddressMap::kNodes] + std::uint64_t(i) * sizeof(Node), sizeof(Node), words,
                          node_counts);
         std::memcpy(&node_, words, sizeof(Node));
         return node_;
     }
-    CELLRT_HD void touch_node(std::uint32_t) const {}
+    // The kernels announce a child pair (siblings are adjacent) as soon as they read its parent.
+    CELLRT_HD void touch_node(std::uint32_t i) {
+        if (async_)
+            node_cache_.touch(map_, map_.base[CacheAddressMap::kNodes] + std::uint64_t(i) * sizeof(Node), 2 * sizeof(Node),
+                              fills_, node_counts);
+    }
     CELLRT_HD std::uint32_t index(std::uint32_t k) {
+        node_cache_.complete(map_, fills_);
         std::uint32_t entry;
         node_cache_.read(map_, map_.base[CacheAddressMap::kEntries] + std::uint64_t(k) * sizeof entry, sizeof entry,
                          &entry, node_counts);
@@ -278,6 +387,8 @@ private:
     static_assert(sizeof(Node) % 4 == 0 && sizeof(Triangle) % 4 == 0, "the caches copy whole 32-bit words");
     SharedCache node_cache_, triangle_cache_;
     CacheAddressMap map_;
+    bool async_;
+    AsyncFills fills_;  // the node cache's fills this thread started and has not waited for
     Node node_;
     Triangle triangle_;
 };

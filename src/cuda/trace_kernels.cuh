@@ -64,12 +64,15 @@ __device__ inline void add_counts(DeviceCacheCounts& to, const DeviceCacheCounts
     atomicAdd(&to.evictions, c.evictions);
     atomicAdd(&to.torn, c.torn);
     atomicAdd(&to.unfilled, c.unfilled);
+    atomicAdd(&to.prefetches, c.prefetches);
+    atomicAdd(&to.touch_hits, c.touch_hits);
 }
 
 // Memory mode (b): the layouts of a block's two caches, which lie one after the other in its dynamic
 // shared memory (the node cache first; each a multiple of 16 bytes long).
 struct SharedCaches {
     SharedCacheLayout node_cache, triangle_cache;
+    bool async;  // asynchronous access (touch, then wait)
 };
 
 // The tree's memory for one block: direct (mode (a)), or (kShared, mode (b)) the block's caches, which
@@ -87,7 +90,7 @@ __device__ void with_block_memory(const TreeView<Traits>& view, const PackedTree
         triangle_cache.clear(threadIdx.x, blockDim.x);
         __syncthreads();
         const CacheAddressMap map = cache_address_map(view, layout.nodes, layout.entries, layout.triangles);
-        SharedCacheMemory<typename Traits::Node> mem(node_cache, triangle_cache, map);
+        SharedCacheMemory<typename Traits::Node> mem(node_cache, triangle_cache, map, caches.async);
         fn(mem);
         add_counts(block_counts[2 * blockIdx.x], mem.node_counts);
         add_counts(block_counts[2 * blockIdx.x + 1], mem.triangle_counts);
@@ -172,7 +175,7 @@ void launch_trace(const std::byte* tree, const PackedTree& layout, const Ray* ra
             DeviceCacheCounts* block_counts) {
             kernel<<<blocks, kBlockThreads, shared_bytes, stream>>>(
                 tree, layout, rays, hits, occluded, n, next, counters ? counts : nullptr,
-                SharedCaches{memory.node_cache, memory.triangle_cache}, block_counts);
+                SharedCaches{memory.node_cache, memory.triangle_cache, memory.async}, block_counts);
         });
     if (counters) {
         counters->rays += n;
@@ -239,7 +242,7 @@ std::uint64_t launch_frame(const std::byte* tree, const PackedTree& layout, cons
             DeviceCacheCounts* block_counts) {
             kernel<<<blocks, kBlockThreads, shared_bytes, stream>>>(
                 tree, layout, triangles, frame, window, pixels, tiles, next, counts,
-                SharedCaches{memory.node_cache, memory.triangle_cache}, block_counts);
+                SharedCaches{memory.node_cache, memory.triangle_cache, memory.async}, block_counts);
         });
     const auto add = [](TraversalCounters& to, const DeviceCounts& c, std::uint64_t rays) {
         to.rays += rays;
