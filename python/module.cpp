@@ -12,6 +12,7 @@
 #include "batch.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
+#include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
@@ -36,14 +37,18 @@ std::string param_value(py::handle value, const std::string& name) {
     throw py::value_error(name + " must be a str, bool, int or float, got " + py::repr(value).cast<std::string>());
 }
 
-// kind "KIND[:TRAVERSAL]", the SIMD set, the build threads and the structure's parameters.
-AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, py::handle params) {
+// kind "KIND[:TRAVERSAL]", the SIMD set, the build threads, the structure's parameters and the device.
+// On the GPU (device "cuda") simd "auto" is its own one-ray-a-thread kernels, as the CLI's --device
+// cuda without --simd; any other SIMD set is refused there by the library.
+AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, py::handle params, py::handle device) {
     const std::string spec = text(kind, "kind");
     if (spec.find_first_of("+@") != std::string::npos)
         throw py::value_error("kind '" + spec + "' must be KIND or KIND:TRAVERSAL; pass the SIMD set as simd= and "
                               "parameters as params=");
     AccelConfig c = parse_accel_config(spec);
     c.simd = text(simd, "simd");
+    c.device = text(device, "device");
+    if (c.device == "cuda" && c.simd == "auto") c.simd = "off";
     c.threads = small_count(threads, "threads", kMaxWorkers);
     if (!py::isinstance<py::dict>(params))
         throw py::value_error("params must be a dict of name: value, got " + py::repr(params).cast<std::string>());
@@ -135,11 +140,11 @@ py::array image_array(Image image) {
 }
 
 py::array render_scene(py::handle scene_object, py::handle kind, py::handle size, py::handle shading,
-                       py::handle threads, py::handle ao_samples) {
+                       py::handle threads, py::handle ao_samples, py::handle device) {
     if (!py::isinstance<Scene>(scene_object))
         throw py::value_error("scene must be a cellrt.Scene (cellrt.load_scene), got " +
                               py::repr(scene_object).cast<std::string>());
-    AccelConfig config = accel_config(kind, py::str("auto"), threads, py::dict());
+    AccelConfig config = accel_config(kind, py::str("auto"), threads, py::dict(), device);
     if (!config.traversal.empty()) config.simd = "off";  // a single-ray kernel named, as the CLI's --traversal
     RenderOptions ro;
     ro.threads = config.threads;
@@ -241,15 +246,16 @@ PYBIND11_MODULE(cellrt, m) {
                               "An acceleration structure over triangles. intersect() and occluded() may run at once "
                               "from any number of Python threads; each releases the GIL while it traces.")
         .def(py::init([](py::handle first, py::handle faces, py::handle kind, py::handle simd, py::handle threads,
-                         py::handle params) {
-                 const AccelConfig config = accel_config(kind, simd, threads, params);
+                         py::handle params, py::handle device) {
+                 const AccelConfig config = accel_config(kind, simd, threads, params, device);
                  return build(faces.is_none() ? triangle_soup(first) : indexed_triangles(first, faces), config);
              }),
              py::arg("vertices"), py::arg("faces") = py::none(), py::kw_only(), py::arg("kind") = "kd",
              py::arg("simd") = "auto", py::arg("threads") = 0, py::arg("params") = py::dict(),
-             "Accelerator(vertices (N,3), faces (M,3), kind='kd', simd='auto', threads=0, params={}), or "
-             "Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); the GIL is "
-             "released during the build.")
+             py::arg("device") = "cpu",
+             "Accelerator(vertices (N,3), faces (M,3), kind='kd', simd='auto', threads=0, params={}, device='cpu'), "
+             "or Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); device: 'cpu' "
+             "or 'cuda' (cellrt.device_info()); the GIL is released during the build.")
         .def("intersect", &py_intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0,
              py::arg("tfar") = std::numeric_limits<double>::infinity(),
              "Closest hits: dict of arrays t (inf on a miss), prim (int64, -1 on a miss), u, v.")
@@ -310,8 +316,24 @@ PYBIND11_MODULE(cellrt, m) {
           "cellrt.Error with the library's message naming the file and line.");
     m.def("render", &render_scene, py::arg("scene"), py::kw_only(), py::arg("kind") = "kd",
           py::arg("size") = py::none(), py::arg("shading") = "direct", py::arg("threads") = 0, py::arg("ao_samples") = 4,
+          py::arg("device") = "cpu",
           "The scene rendered as cellrt render renders it: an (H, W, 3) float32 array, the values of its PFM, row 0 "
-          "at the top.");
+          "at the top. device='cuda': every pixel made on the GPU, the same array bit for bit.");
+    m.def(
+        "device_info",
+        [] {
+            const DeviceInfo d = cuda_device_info();
+            py::dict out;
+            out["present"] = d.present;
+            out["name"] = d.name;
+            out["compute_capability"] = py::make_tuple(d.compute_major, d.compute_minor);
+            out["multiprocessors"] = d.multiprocessors;
+            out["memory_bytes"] = d.memory_bytes;
+            out["reason"] = d.reason;
+            return out;
+        },
+        "The CUDA device device='cuda' would use, as cellrt info --device cuda names it: a dict with present, name, "
+        "compute_capability, multiprocessors, memory_bytes, and the reason when there is none.");
     m.def("kinds", &accelerator_kinds, "The accelerator kinds of this build.");
 
     // For the tests and the benchmark.

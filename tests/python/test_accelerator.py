@@ -184,3 +184,28 @@ def test_degenerate_rays_miss():
     r = acc.intersect(o, d, tnear=np.array([0, 0, 2], np.float32))
     assert r["prim"].tolist() == [0, -1, -1]
     assert r["t"][0] == 1.0 and abs(r["u"][0] - 0.2) < 1e-6 and abs(r["v"][0] - 0.2) < 1e-6
+
+
+@pytest.fixture(scope="module")
+def gpu():
+    info = cellrt.device_info()
+    if not info["present"]:
+        pytest.skip("no CUDA device: " + info["reason"])
+    return info
+
+
+@pytest.mark.parametrize("kind", ["kd", "bih:branchless"])
+def test_the_gpu_answers_as_brute_force(gpu, case, kind):
+    scene, rays, hits, occluded = case
+    acc = cellrt.Accelerator(scene.triangles, kind=kind, device="cuda")
+    assert_same_hits(acc.intersect(*rays), hits)
+    assert np.array_equal(acc.occluded(*rays), occluded)
+    assert "cuda" in str(acc.stats.settings)
+
+
+@pytest.mark.parametrize("shading", ["direct", "ao", "diffuse"])
+def test_the_gpu_renders_the_cpus_image(gpu, city, shading):
+    cpu = cellrt.render(city, size=(61, 43), shading=shading)
+    for kind in ("kd", "bih"):
+        on_gpu = cellrt.render(city, kind=kind, size=(61, 43), shading=shading, device="cuda")
+        assert np.array_equal(on_gpu.view(np.int32), cpu.view(np.int32)), kind

@@ -84,6 +84,8 @@ def test_bad_indexed_mesh(vertices, faces, match):
     ({"params": [("leaf_size", 2)]}, "params must be a dict"),
     ({"params": {1: 2}}, "a key of params must be a str, got 1"),
     ({"params": {"leaf_size": [2]}}, r"params\['leaf_size'\] must be a str, bool, int or float"),
+    ({"device": 0}, "device must be a str, got 0"),
+    ({"device": "tpu"}, "device 'tpu' is not one of: cpu, cuda"),
 ])
 def test_bad_options(kwargs, match):
     refused(match, cellrt.Accelerator, TRI, **kwargs)
@@ -170,3 +172,16 @@ def test_bad_scene_properties():
         scene.triangles[0, 0, 0] = 5.0
     with pytest.raises(cellrt.Error, match="image size 0x4"):
         scene.camera.rays(0, 4)
+
+
+def test_a_missing_gpu_is_a_library_error_naming_why():
+    info = cellrt.device_info()
+    assert set(info) == {"present", "name", "compute_capability", "multiprocessors", "memory_bytes", "reason"}
+    if info["present"]:
+        pytest.skip("a CUDA device is present: " + info["name"])
+    assert info["reason"]
+    for call in (lambda: cellrt.Accelerator(TRI, device="cuda"),
+                 lambda: cellrt.render(cellrt.Scene(TRI), size=(8, 8), device="cuda")):
+        with pytest.raises(cellrt.Error) as e:
+            call()
+        assert str(e.value) == "device 'cuda': " + info["reason"]
