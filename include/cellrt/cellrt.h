@@ -38,7 +38,7 @@ extern "C" {
 #endif
 
 /* The version of this API; changes when a declaration below changes. */
-#define CELLRT_C_API_VERSION 1
+#define CELLRT_C_API_VERSION 2
 
 /* prim of a ray that hits nothing. */
 #define CELLRT_INVALID_ID UINT32_MAX
@@ -119,6 +119,11 @@ CELLRT_API cellrt_error cellrt_scene_get_info(cellrt_scene scene, size_t* triang
  * KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd", "bih:branchless", "kd+auto@leaf_size=2", "brute";
  * NULL is "kd". Its kinds, traversals and parameters are those of `cellrt list`. */
 CELLRT_API cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config);
+/* The same, traced where `where` says: "cpu" (or NULL), as cellrt_accel_new; "cuda": the tree built on
+ * the host and traced on the GPU, one ray per GPU thread (kinds kd and bih, no SIMD set; docs/GPU.md).
+ * An unknown place, or "cuda" where there is no GPU or no CUDA in this build, is INVALID_CONFIG with
+ * the reason. Since version 2. */
+CELLRT_API cellrt_accel cellrt_accel_new_on(cellrt_scene scene, const char* config, const char* where);
 CELLRT_API cellrt_error cellrt_accel_retain(cellrt_accel accel);
 CELLRT_API cellrt_error cellrt_accel_release(cellrt_accel accel);
 

@@ -313,24 +313,40 @@ cellrt_error cellrt_scene_get_info(cellrt_scene scene, size_t* triangle_count, f
     });
 }
 
-cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config) {
+namespace {
+
+// cellrt_accel_new and cellrt_accel_new_on: `where` NULL is the CPU, and the message names it only
+// when given.
+cellrt_accel new_accel(const char* name, cellrt_scene scene, const char* config, const char* where) {
     std::shared_ptr<Device> d;
     std::uint64_t id = 0;
-    guarded("cellrt_accel_new", d, [&] {
+    guarded(name, d, [&] {
         const auto s = find<SceneData>(id_of(scene), "scene");
         d = s->device;
         auto accel = std::make_shared<Accel>();
         accel->device = d;
         accel->scene = s;
         try {
-            const cellrt::AccelConfig c = config ? cellrt::parse_accel_config(config) : cellrt::AccelConfig{};
+            cellrt::AccelConfig c = config ? cellrt::parse_accel_config(config) : cellrt::AccelConfig{};
+            if (where) c.device = where;
             accel->accelerator = cellrt::make_accelerator(s->triangles, c);
         } catch (const cellrt::Error& e) {
-            fail(CELLRT_ERROR_INVALID_CONFIG, "config '" + std::string(config ? config : "") + "': " + e.what());
+            fail(CELLRT_ERROR_INVALID_CONFIG, "config '" + std::string(config ? config : "") + "'" +
+                                                  (where ? " on '" + std::string(where) + "'" : "") + ": " + e.what());
         }
         id = table().add(std::move(accel));
     });
     return handle_of<cellrt_accel>(id);
+}
+
+}  // namespace
+
+cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config) {
+    return new_accel("cellrt_accel_new", scene, config, nullptr);
+}
+
+cellrt_accel cellrt_accel_new_on(cellrt_scene scene, const char* config, const char* where) {
+    return new_accel("cellrt_accel_new_on", scene, config, where);
 }
 
 cellrt_error cellrt_accel_retain(cellrt_accel accel) {

@@ -354,6 +354,23 @@ static int part_errors(void) {
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "leaf_size");
     kd = cellrt_accel_new(scene, NULL); /* NULL: the default, the kd-tree */
     CHECK(kd != NULL);
+    /* Where it runs: the CPU by name or by NULL; an unknown place refused; the GPU, or the reason
+     * there is none (CI has none: the GPU's answers are tested by the C++ suite where it has one). */
+    CHECK(cellrt_accel_new_on(scene, "kd", "tpu") == NULL);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "config 'kd' on 'tpu': device 'tpu' is not one of: cpu, cuda");
+    CHECK(cellrt_accel_new_on(scene, "kd+avx2", "cuda") == NULL);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "config 'kd+avx2' on 'cuda'");
+    for (int k = 0; k < 2; ++k) {
+        cellrt_accel here = cellrt_accel_new_on(scene, "kd", k ? "cpu" : NULL);
+        CHECK(here != NULL && cellrt_accel_release(here) == CELLRT_SUCCESS);
+    }
+    accel = cellrt_accel_new_on(scene, "bih", "cuda");
+    if (accel) {
+        CHECK(cellrt_intersect(accel, &ray, &hit, 1) == CELLRT_SUCCESS);
+        CHECK(cellrt_accel_release(accel) == CELLRT_SUCCESS);
+    } else {
+        CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "config 'bih' on 'cuda': device 'cuda': ");
+    }
     accel = cellrt_accel_new(empty, "bih");
     CHECK(accel != NULL);
     CHECK(cellrt_intersect(accel, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == CELLRT_INVALID_ID && isinf(hit.t));
