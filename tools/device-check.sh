@@ -3,7 +3,7 @@
 #
 #   tools/device-check.sh prepare DIR   # here: build with CUDA and the benchmarks, pack the programs, their
 #                                       # libraries and the shared scenes into DIR (git-ignored), compressed:
-#                                       # about 26 MB against the device tool's 64 MiB carry limit
+#                                       # about 26 MB (43 MB from a build with MPI) against the 64 MiB carry limit
 #   tools/device-check.sh run DIR       # there, in one go (about 8 minutes at most): results under $OUT
 #
 # `run` writes $OUT/info.txt (`cellrt info --device cuda`), $OUT/gpu_tests.json (the GPU tests, GoogleTest's
