@@ -111,6 +111,13 @@ CacheAddressMap nodes_only(const std::vector<std::uint32_t>& words) {
     return map;
 }
 
+// 64 words numbered from `first`: each read's bytes say where they came from.
+std::vector<std::uint32_t> numbered(std::uint32_t first) {
+    std::vector<std::uint32_t> words(64);
+    for (std::size_t i = 0; i < words.size(); ++i) words[i] = first + static_cast<std::uint32_t>(i);
+    return words;
+}
+
 // Worked by hand: one set of four 16-byte ways, least recently used replacement.
 TEST(SharedCache, FourWayLruByHand) {
     const std::vector<std::uint32_t> bytes(1024, 0x5a5a5a5a);
@@ -138,8 +145,7 @@ TEST(SharedCache, FourWayLruByHand) {
 // number is odd (being filled) is neither read nor claimed, and the read takes its bytes from global
 // memory, counted unfilled; once the number is even again the line is the cache's.
 TEST(SharedCache, ALineBeingFilledIsReadFromGlobalMemory) {
-    std::vector<std::uint32_t> bytes(64);
-    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = 1000 + static_cast<std::uint32_t>(i);
+    const std::vector<std::uint32_t> bytes = numbered(1000);
     const CacheAddressMap map = nodes_only(bytes);
     const SharedCacheLayout layout{16, 4, 1};
     HostCache c(layout);
@@ -169,8 +175,7 @@ TEST(SharedCache, ALineBeingFilledIsReadFromGlobalMemory) {
 // slot and reads global memory; the wait publishes the line, whose bytes the next read finds; and a
 // touch of a line already there is a touch hit.
 TEST(SharedCache, ATouchedLineIsInFlightUntilTheWait) {
-    std::vector<std::uint32_t> bytes(64);
-    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = 2000 + static_cast<std::uint32_t>(i);
+    const std::vector<std::uint32_t> bytes = numbered(2000);
     const CacheAddressMap map = nodes_only(bytes);
     const SharedCacheLayout layout{32, 4, 1};
     HostCache c(layout);
