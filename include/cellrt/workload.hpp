@@ -30,12 +30,9 @@ Shading parse_shading(const std::string& name);  // "direct" | "ao" | "diffuse";
 const char* to_string(Shading s);
 std::vector<std::string> shading_names();
 
-// Throws cellrt::Error for AO samples outside [1, kMaxAoSamples].
-void check_shading(const ShadingOptions& shading);
-// The reach of the AO rays in `scene`: kAoReachFraction of its box's diagonal.
-float ao_reach(const Scene& scene);
-// What shade_pixel (shading.hpp) needs of a frame of `scene` seen through `camera`: the GPU's frame
-// path. Throws as check_shading does.
+// What the rays of a frame of `scene` seen through `camera` are made from (shading.hpp): the packets'
+// workload and the GPU's frame path (shade_pixel) alike; the AO rays reach kAoReachFraction of the
+// scene box's diagonal. Throws cellrt::Error for AO samples outside [1, kMaxAoSamples].
 FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading);
 
 // The kinds of rays a packet casts. Primary and bounce rays ask for the closest hit, the others for
@@ -62,7 +59,7 @@ struct RayBatch {
 
 // One packet's rays and what the accelerator answered, in buffers kept from packet to packet: a worker
 // holds one and traces packet after packet without allocating, for packets of up to `max_pixels`.
-// `scene` and `camera` are referenced, not copied: they must outlive it. trace() writes the buffers,
+// `scene` is referenced, not copied: it must outlive it (the camera is copied). trace() writes the buffers,
 // so a workload is one thread's (one per worker); the accelerator it is given may be shared, and must
 // have been built over scene.triangles (the rays cast from a hit read the triangle it names). Throws
 // cellrt::Error for AO samples out of range.
@@ -87,14 +84,12 @@ public:
     RayBatch batch(RayKind k) const;
     // Rays traced for the last packet, every kind.
     std::size_t ray_count() const;
-    const ShadingOptions& shading() const { return shading_; }
+    const ShadingOptions& shading() const { return frame_.shading; }
 
 private:
     struct Buffers;
     const Scene* scene_;
-    const PinholeCamera* camera_;
-    ShadingOptions shading_;
-    float ao_reach_;
+    FrameShading frame_;  // the camera, the light and the shading, as the GPU's frame path has them
     std::unique_ptr<Buffers> buffers_;  // on cache lines of their own (workers write them on every packet)
 };
 

@@ -10,8 +10,8 @@
 #include <cuda_runtime.h>
 
 #include <mutex>
-#include <type_traits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cellrt/device.hpp"
@@ -83,12 +83,14 @@ public:
     FrameResult render_frame(std::span<const Triangle> triangles, const FrameShading& frame, int x0, int y0, int width,
                              int height, std::span<Vec3> pixels, TraversalCounters& primary,
                              TraversalCounters& secondary) const override {
-        const std::string window = std::to_string(width) + "x" + std::to_string(height) + " at (" + std::to_string(x0) +
-                                   ", " + std::to_string(y0) + ")";
-        if (width < 1 || height < 1) throw Error("device frame: the window " + window + " is empty");
+        const auto window = [&] {
+            return std::to_string(width) + "x" + std::to_string(height) + " at (" + std::to_string(x0) + ", " +
+                   std::to_string(y0) + ")";
+        };
+        if (width < 1 || height < 1) throw Error("device frame: the window " + window() + " is empty");
         const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
         if (pixels.size() != n)
-            throw Error("device frame: " + std::to_string(pixels.size()) + " pixels given for the window " + window);
+            throw Error("device frame: " + std::to_string(pixels.size()) + " pixels given for the window " + window());
         if (triangles.size() != scene_triangles_)
             throw Error("device frame: " + std::to_string(triangles.size()) + " triangles given for a tree built over " +
                         std::to_string(scene_triangles_));

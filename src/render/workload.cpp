@@ -25,22 +25,16 @@ const char* to_string(Shading s) { return detail::name_of(kShadings, s); }
 std::vector<std::string> shading_names() { return detail::names_of(kShadings); }
 const char* to_string(RayKind k) { return detail::name_of(kRayKindNames, k); }
 
-void check_shading(const ShadingOptions& shading) {
+FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading) {
     if (shading.ao_samples < 1 || shading.ao_samples > kMaxAoSamples)
         throw Error("AO samples " + std::to_string(shading.ao_samples) + " must lie in [1, " +
                     std::to_string(kMaxAoSamples) + "]");
-}
-
-float ao_reach(const Scene& scene) { return kAoReachFraction * length(scene.bounds().extent()); }
-
-FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading) {
-    check_shading(shading);
     FrameShading f;
     f.camera = camera.projection();
     f.light_position = scene.light.position;
     f.light_color = scene.light.color;
     f.shading = shading;
-    f.ao_reach = ao_reach(scene);
+    f.ao_reach = kAoReachFraction * length(scene.bounds().extent());
     f.frame_width = camera.width();
     return f;
 }
@@ -108,9 +102,8 @@ struct alignas(kCacheLine) PacketWorkload::Buffers {
 
 PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
                                const ShadingOptions& shading)
-    : scene_(&scene), camera_(&camera), shading_(shading), buffers_(std::make_unique<Buffers>()) {
-    check_shading(shading);
-    ao_reach_ = ao_reach(scene);
+    : scene_(&scene), frame_(frame_shading(scene, camera, shading)),
+      buffers_(std::make_unique<Buffers>()) {
     Buffers& b = *buffers_;
     b.order.reserve(max_pixels);
     b.pixel.reserve(max_pixels);
@@ -142,22 +135,22 @@ void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, Trav
     RayBuffers& prim = b[RayKind::primary];
     for (const std::uint32_t p : b.order) {
         const int x = rect.x0 + static_cast<int>(p) % rect.width(), y = rect.y0 + static_cast<int>(p) / rect.width();
-        prim.rays.push_back(camera_->primary(x, y));
-        b.pixel.push_back(static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(camera_->width()) +
+        prim.rays.push_back(frame_.camera.primary(x, y));
+        b.pixel.push_back(static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(frame_.frame_width) +
                           static_cast<std::uint64_t>(x));
     }
     prim.trace(accel, RayKind::primary, primary);
 
-    const Vec3 light = scene_->light.position;
+    const Vec3 light = frame_.light_position;
     for (std::size_t i = 0; i < prim.rays.size(); ++i) {
         const Hit& h = prim.hits[i];
         if (!h.is_hit()) continue;
         const SurfacePoint sp = surface_point(scene_->triangles[h.prim], prim.rays[i], h);
-        switch (shading_.shading) {
+        switch (frame_.shading.shading) {
             case Shading::direct: b[RayKind::shadow].add(shadow_ray(sp.position, sp.normal, light), i, sp.normal); break;
             case Shading::ao:
-                for (int s = 0; s < shading_.ao_samples; ++s)
-                    b[RayKind::ao].add(hemisphere_ray(sp, b.pixel[i], static_cast<std::uint32_t>(s), kAoDims, ao_reach_),
+                for (int s = 0; s < frame_.shading.ao_samples; ++s)
+                    b[RayKind::ao].add(hemisphere_ray(sp, b.pixel[i], static_cast<std::uint32_t>(s), kAoDims, frame_.ao_reach),
                                        i, sp.normal);
                 break;
             case Shading::diffuse:
@@ -168,12 +161,12 @@ void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, Trav
     }
     // Every batch the shading casts is traced, empty or not: an accelerator sees the same calls for
     // every packet.
-    if (shading_.shading == Shading::ao) {
+    if (frame_.shading.shading == Shading::ao) {
         b[RayKind::ao].trace(accel, RayKind::ao, secondary);
         return;
     }
     b[RayKind::shadow].trace(accel, RayKind::shadow, secondary);
-    if (shading_.shading == Shading::direct) return;
+    if (frame_.shading.shading == Shading::direct) return;
 
     RayBuffers& bounce = b[RayKind::bounce];
     bounce.trace(accel, RayKind::bounce, secondary);
