@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <map>
 #include <random>
 
@@ -138,6 +139,66 @@ TEST(Watertight, InvalidRaysHitNothing) {
                          Ray{{0.f, 0.f, 1.f}, 2.f, {0.f, 0.f, -1.f}, 1.f},
                          Ray{{0.f, 0.f, 1.f}, nan, {0.f, 0.f, -1.f}, kInfinity}})
         EXPECT_FALSE(closest(std::span(&tri, 1), r).is_hit());
+}
+
+// The SSE2 test (three vertices in three lanes) against the scalar one it replaces on x86-64: the
+// same answer and the same bits of t, u and v, on random triangles and rays, degenerate triangles,
+// axis-parallel rays with +0 and -0 components, and rays through vertices and edge points (edge
+// functions of exactly zero, which go through the double-precision recomputation).
+TEST(Watertight, SseTestEqualsTheScalarTestBitForBit) {
+#if !defined(CELLRT_SSE2_TRIANGLE)
+    GTEST_SKIP() << "no SSE2 triangle test on this target: every path runs the scalar test";
+#else
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    auto point = [&](float scale) { return Vec3{u(rng), u(rng), u(rng)} * scale; };
+    std::vector<Triangle> tris;
+    for (int i = 0; i < 300; ++i) {
+        const float scale = i % 3 == 0 ? 1e-3f : (i % 3 == 1 ? 1.f : 1e4f);
+        const Vec3 a = point(scale), b = point(scale), c = point(scale);
+        tris.push_back({a, b, c});
+        if (i % 10 == 0) tris.push_back({a, a, c});                         // two equal vertices
+        if (i % 10 == 1) tris.push_back({a, (a + c) * 0.5f, c});            // collinear
+        if (i % 10 == 2) tris.push_back({{a.x, a.y, 0.f}, {b.x, b.y, 0.f}, {c.x, c.y, 0.f}});  // in a plane z = 0
+    }
+    detail::MeshBuilder(tris).sphere({0.1f, -0.2f, 0.3f}, 1.3f, 12, 6);
+    std::size_t hits = 0, zero_edges = 0, outside = 0;
+    auto check = [&](const Ray& ray, const Triangle& tri) {
+        if (!is_valid(ray)) return;
+        const WatertightRay w(ray);
+        float t0 = 1.f, u0 = 2.f, v0 = 3.f, t1 = 1.f, u1 = 2.f, v1 = 3.f;
+        const bool scalar = intersect_unbounded_scalar(w, tri, t0, u0, v0);
+        const bool sse = intersect_unbounded_sse(w, tri, t1, u1, v1);
+        ASSERT_EQ(scalar, sse);
+        if (scalar) {
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(t0), std::bit_cast<std::uint32_t>(t1));
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(u0), std::bit_cast<std::uint32_t>(u1));
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(v0), std::bit_cast<std::uint32_t>(v1));
+            ++hits;
+            zero_edges += u0 == 0.f || v0 == 0.f || u0 + v0 == 1.f;
+        } else {
+            ++outside;
+        }
+    };
+    for (const Triangle& tri : tris) {
+        const Vec3 corners[3] = {tri.v0, tri.v1, tri.v2};
+        for (int k = 0; k < 40; ++k) {
+            const Vec3 target = k < 3 ? corners[k] : (k < 6 ? (corners[k - 3] + corners[(k - 2) % 3]) * 0.5f
+                                                            : corners[0] + (corners[1] - corners[0]) * (0.5f * (u(rng) + 1.f)) +
+                                                                  (corners[2] - corners[0]) * (0.25f * (u(rng) + 1.f)));
+            Ray ray;
+            ray.org = k % 4 == 0 ? point(10.f) : target + point(3.f);
+            ray.dir = target - ray.org;
+            if (k % 5 == 0) ray.dir = {0.f, 0.f, k % 2 ? -1.f : 1.f};         // axis-parallel
+            if (k % 7 == 0) ray.dir = {-0.f, ray.dir.y, ray.dir.z};             // a -0 component
+            if (k % 9 == 0) ray.dir = {1.f, 1.f, k % 2 ? 1.f : -1.f};           // ties for the largest axis
+            check(ray, tri);
+        }
+    }
+    EXPECT_GT(hits, 1000u);
+    EXPECT_GT(zero_edges, 100u) << "the catalogue must reach edge functions of exactly zero";
+    EXPECT_GT(outside, 1000u);
+#endif
 }
 
 }  // namespace

@@ -16,6 +16,11 @@
 #include <type_traits>
 #include <utility>
 
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+#include <emmintrin.h>
+#define CELLRT_SSE2_TRIANGLE 1
+#endif
+
 #include "cellrt/box.hpp"
 #include "cellrt/host_device.hpp"
 #include "cellrt/ray.hpp"
@@ -63,7 +68,7 @@ struct WatertightRay {
 // (det == 0: zero area, or seen edge-on). Always inlined, as the per-ray set-up of the traversals
 // (kernel/traversal.hpp): a unit that instantiates many kernels exhausts GCC's inlining budget,
 // and an out-of-line call costs a kernel up to a tenth of its instructions (docs/BENCHMARKS.md).
-[[gnu::always_inline]] CELLRT_HD inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+[[gnu::always_inline]] CELLRT_HD inline bool intersect_unbounded_scalar(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     // The vertices' coordinates in ray order (x, y, z of v0, v1, v2: the nine floats of the
     // triangle's storage, read in place by index as Vec3::operator[] reads three).
     const float* c9 = reinterpret_cast<const float*>(&tri);
@@ -92,11 +97,62 @@ struct WatertightRay {
     return true;
 }
 
+#if defined(CELLRT_SSE2_TRIANGLE)
+// The scalar test out of line, for the SSE2 test's rare edge functions of exactly zero: inlined, its
+// registers would crowd the common path's.
+[[gnu::noinline]] inline bool intersect_unbounded_exact_edges(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+    return intersect_unbounded_scalar(r, tri, t, u, v);
+}
+
+// The same test with the three vertices in the lanes of SSE2 registers (lane 0: v0, 1: v1, 2: v2):
+// each lane runs the scalar test's operations in the same order, so every value carries the same
+// bits (tests/test_watertight.cpp compares the two on random, degenerate, axis-parallel and
+// edge-point rays). An edge function of exactly zero goes to the scalar test, whose double-precision
+// recomputation decides it.
+[[gnu::always_inline]] inline bool intersect_unbounded_sse(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+    const float* c9 = reinterpret_cast<const float*>(&tri);
+    const __m128 cz = _mm_setr_ps(c9[r.kz], c9[3 + r.kz], c9[6 + r.kz], 0.f);
+    const __m128 cx = _mm_setr_ps(c9[r.kx], c9[3 + r.kx], c9[6 + r.kx], 0.f);
+    const __m128 cy = _mm_setr_ps(c9[r.ky], c9[3 + r.ky], c9[6 + r.ky], 0.f);
+    const __m128 dz = _mm_sub_ps(cz, _mm_set1_ps(r.org[r.kz]));  // a_kz, b_kz, c_kz
+    const __m128 x = _mm_sub_ps(_mm_sub_ps(cx, _mm_set1_ps(r.org[r.kx])), _mm_mul_ps(_mm_set1_ps(r.sx), dz));
+    const __m128 y = _mm_sub_ps(_mm_sub_ps(cy, _mm_set1_ps(r.org[r.ky])), _mm_mul_ps(_mm_set1_ps(r.sy), dz));
+    // (eu, ev, ew) = (cx by - cy bx, ax cy - ay cx, bx ay - by ax): lanes (c, a, b) times (b, c, a).
+    const __m128 x1 = _mm_shuffle_ps(x, x, _MM_SHUFFLE(3, 0, 2, 1)), x2 = _mm_shuffle_ps(x, x, _MM_SHUFFLE(3, 1, 0, 2));
+    const __m128 y1 = _mm_shuffle_ps(y, y, _MM_SHUFFLE(3, 0, 2, 1)), y2 = _mm_shuffle_ps(y, y, _MM_SHUFFLE(3, 1, 0, 2));
+    const __m128 e = _mm_sub_ps(_mm_mul_ps(x2, y1), _mm_mul_ps(y2, x1));
+    const __m128 zero = _mm_setzero_ps();
+    if ((_mm_movemask_ps(_mm_cmpeq_ps(e, zero)) & 7) != 0) return intersect_unbounded_exact_edges(r, tri, t, u, v);
+    if ((_mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7) != 0 && (_mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7) != 0)
+        return false;
+    const float eu = _mm_cvtss_f32(e), ev = _mm_cvtss_f32(_mm_shuffle_ps(e, e, 1)), ew = _mm_cvtss_f32(_mm_movehl_ps(e, e));
+    // Three non-zero edges of one sign: their sum is not zero (the scalar test's det == 0 case
+    // needs a zero edge, which went to it above).
+    const float det = eu + ev + ew;
+    const __m128 p = _mm_mul_ps(e, _mm_mul_ps(_mm_set1_ps(r.sz), dz));  // eu az, ev bz, ew cz
+    const float big_t = (_mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1))) + _mm_cvtss_f32(_mm_movehl_ps(p, p));
+    const float inv_det = 1.f / det;
+    t = big_t * inv_det;
+    u = ev * inv_det;
+    v = ew * inv_det;
+    return true;
+}
+#endif
+
+// The test every path calls: SSE2's on x86-64 hosts, the scalar one elsewhere and on devices.
+[[gnu::always_inline]] CELLRT_HD inline bool intersect_unbounded(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+#if defined(CELLRT_SSE2_TRIANGLE)
+    return intersect_unbounded_sse(r, tri, t, u, v);
+#else
+    return intersect_unbounded_scalar(r, tri, t, u, v);
+#endif
+}
+
 // Closest-hit step: updates `best` when the triangle is hit at ray.tnear <= t <= best.t and is
 // preferred by the hit rule (ray.hpp). Returns whether `best` changed. `prim` is the triangle's index,
 // or a callable returning it (read only when the hit is a candidate, for structures that keep it apart).
 template <class Prim>
-CELLRT_HD inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, Prim&& prim, Hit& best) {
+[[gnu::always_inline]] CELLRT_HD inline bool intersect_closest(const WatertightRay& r, float tnear, const Triangle& tri, Prim&& prim, Hit& best) {
     float t, u, v;
     if (!intersect_unbounded(r, tri, t, u, v)) return false;
     if (!(t >= tnear) || !(t <= best.t)) return false;
@@ -109,7 +165,7 @@ CELLRT_HD inline bool intersect_closest(const WatertightRay& r, float tnear, con
 }
 
 // Any-hit step: whether the triangle is hit at tnear <= t <= tfar.
-CELLRT_HD inline bool intersect_any(const WatertightRay& r, float tnear, float tfar, const Triangle& tri) {
+[[gnu::always_inline]] CELLRT_HD inline bool intersect_any(const WatertightRay& r, float tnear, float tfar, const Triangle& tri) {
     float t, u, v;
     return intersect_unbounded(r, tri, t, u, v) && t >= tnear && t <= tfar;
 }
