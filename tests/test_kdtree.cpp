@@ -152,5 +152,30 @@ TEST(KdTree, RejectsBadParameters) {
     EXPECT_THROW(make_accelerator(scene.triangles, kd("stackless")), Error);
 }
 
+// The host's mailbox (two SSE2 registers shifted per insertion) against the devices' (an array
+// written round robin): the same answer for every triangle index of a long sequence, so a kd-tree
+// kernel tests the same triangles on either. Indices from a small range repeat often, as a ray's do
+// across neighbouring leaves; ~0u, the empty slots' value, is among them (both report it as seen
+// until the slots have filled).
+TEST(KdTree, MailboxQueueHoldsWhatTheArrayHolds) {
+#if !defined(__SSE2__)
+    GTEST_SKIP() << "no SSE2 mailbox on this target: every kernel uses the array";
+#else
+    std::mt19937 rng(3);
+    for (const std::uint32_t range : {4u, 9u, 12u, 40u}) {
+        detail::RecentTrianglesArray array;
+        detail::RecentTrianglesSse sse;
+        std::size_t repeats = 0;
+        for (int i = 0; i < 20000; ++i) {
+            const std::uint32_t prim = i % 997 == 0 ? ~0u : std::uint32_t(rng() % range);
+            const bool a = array.seen(prim);
+            ASSERT_EQ(a, sse.seen(prim)) << "range " << range << ", step " << i << ", triangle " << prim;
+            repeats += a;
+        }
+        EXPECT_GT(repeats, 100u) << "range " << range;
+    }
+#endif
+}
+
 }  // namespace
 }  // namespace cellrt

@@ -9,15 +9,23 @@
 // memory is direct.
 #pragma once
 
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+#include <emmintrin.h>
+#endif
+
 #include "kernel/stack_traversal.hpp"
 #include "kd_tree.hpp"
 
 namespace cellrt::detail {
 
 // The last few triangles a ray tested (the "mailbox" of Amanatides & Woo 1987; Havran's thesis
-// section 4.5; not the study's mailbox dispatch of src/schedule): a kd-tree references a triangle from every leaf it overlaps, and a ray crossing neighbouring
-// leaves would test it again with the same answer.
-struct RecentTriangles {
+// section 4.5; not the study's mailbox dispatch of src/schedule): a kd-tree references a triangle
+// from every leaf it overlaps, and a ray crossing neighbouring leaves would test it again with the
+// same answer. The last eight distinct triangles, as an array written round robin (devices), or on
+// x86-64 hosts as a queue in two SSE2 registers, compared at once and shifted by one entry per
+// insertion (no store that the next leaf's load would wait on). Both hold the same triangles, so a
+// kernel tests the same ones wherever it runs (KdTree.MailboxQueueHoldsWhatTheArrayHolds).
+struct RecentTrianglesArray {
     static constexpr int kSize = 8;
     std::uint32_t slot[kSize] = {~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u, ~0u};
     unsigned next = 0;
@@ -30,6 +38,23 @@ struct RecentTriangles {
         return found;
     }
 };
+
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+struct RecentTrianglesSse {
+    __m128i newer = _mm_set1_epi32(-1), older = _mm_set1_epi32(-1);  // entries 0-3 and 4-7, newest first
+
+    bool seen(std::uint32_t prim) {
+        const __m128i p = _mm_set1_epi32(static_cast<int>(prim));
+        if (_mm_movemask_epi8(_mm_or_si128(_mm_cmpeq_epi32(newer, p), _mm_cmpeq_epi32(older, p))) != 0) return true;
+        older = _mm_or_si128(_mm_slli_si128(older, 4), _mm_srli_si128(newer, 12));
+        newer = _mm_or_si128(_mm_slli_si128(newer, 4), _mm_cvtsi32_si128(static_cast<int>(prim)));
+        return false;
+    }
+};
+using RecentTriangles = RecentTrianglesSse;
+#else
+using RecentTriangles = RecentTrianglesArray;
+#endif
 
 // The kd-tree's hooks for the shared stack traversals (kernel/stack_traversal.hpp): one plane per
 // inner node, which ends the left child's cell and begins the right one's.
