@@ -167,7 +167,9 @@ float batch_coherence(std::span<const Ray> rays) {
 const ParamTable& routed_params() {
     using enum ParamType;
     static const ParamTable table{
-        {"packets", choice, "kd", 0, 0, {"kd", "bih"}, "the tree whose SIMD packets trace coherent batches"},
+        {"packets", choice, "kd", 0, 0, {"kd", "bih", "bih-sah"},
+         "the tree whose SIMD packets trace coherent batches: the kd-tree, the study's BIH, or the BIH "
+         "built by the SAH (bih@split=sah)"},
         {"coherence", number, "0.9", -1, 1, {},
          "a batch whose neighbouring rays' directions have at least this mean cosine goes to the packets, "
          "any other to the wide BVH (with route=measured: the first guess for its kind of batch)"},
@@ -196,9 +198,11 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     AccelConfig part;
     part.simd = config.simd == "off" ? "auto" : config.simd;  // the packets are the point of the route
     part.threads = config.threads;
-    part.kind = packets;
+    part.kind = packets == "kd" ? "kd" : "bih";
+    if (packets == "bih-sah") part.params = {{"split", "sah"}};
     std::unique_ptr<Accelerator> coherent = make_accelerator(triangles, part);
     part.kind = "bvh";
+    part.params.clear();
     std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, part);
     // Coherence alone never names the streams, so only the measured route holds them.
     std::unique_ptr<Accelerator> stream = streams && measured ? bvh_with_traversal(*bvh, "stream") : nullptr;
