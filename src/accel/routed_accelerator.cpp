@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <map>
 #include <string>
 
 #include "bvh/bvh_accel.hpp"
@@ -198,8 +199,13 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     AccelConfig part;
     part.simd = config.simd == "off" ? "auto" : config.simd;  // the packets are the point of the route
     part.threads = config.threads;
-    part.kind = packets == "kd" ? "kd" : "bih";
-    if (packets == "bih-sah") part.params = {{"split", "sah"}};
+    // The packets' tree for each value of `packets` (checked against the table above): its kind and
+    // build parameters.
+    static const std::map<std::string, AccelConfig> kPacketTrees = {
+        {"kd", {.kind = "kd"}}, {"bih", {.kind = "bih"}}, {"bih-sah", {.kind = "bih", .params = {{"split", "sah"}}}}};
+    const AccelConfig& tree = kPacketTrees.at(packets);
+    part.kind = tree.kind;
+    part.params = tree.params;
     std::unique_ptr<Accelerator> coherent = make_accelerator(triangles, part);
     part.kind = "bvh";
     part.params.clear();
