@@ -4,10 +4,17 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
+#include <set>
 #include <string_view>
+#include <tuple>
 
+#include "ray_suite.hpp"
 #include "sanitizers.hpp"
+#include "scenes.hpp"
+#include "structure_cases.hpp"
 
 namespace cellrt {
 namespace {
@@ -31,6 +38,34 @@ TEST(Sanitizers, TbbRunsOnOneThreadOnlyUnderThreadSanitizer) {
     } else {
         EXPECT_EQ(allowed, static_cast<std::size_t>(tbb::info::default_concurrency()));
     }
+}
+
+// The sanitized runs trace a seventh of each ray suite (test::sanitized_sample): every seventh ray and
+// every invalid one, so that each kind of ray the suite makes is still among them.
+TEST(Sanitizers, SuiteSampleKeepsEveryKindOfRay) {
+    EXPECT_EQ(test::kSanitizedStride, test::kSanitizers.empty() ? 1u : 7u);
+    const std::vector<Ray> rays = test::RaySuite(test::cached_scene("builtin:spheres?tris=600").triangles,
+                                                 test::small_suite()).rays();
+    const std::vector<Ray> sample = test::sanitized_sample(rays, 7);
+    const auto invalid = [](const std::vector<Ray>& rs) { return std::ranges::count_if(rs, test::is_invalid); };
+    EXPECT_EQ(invalid(rays), 7);
+    EXPECT_EQ(invalid(sample), 7);
+    EXPECT_GE(sample.size(), rays.size() / 7);
+    EXPECT_LE(sample.size(), rays.size() / 7 + 1 + 7);
+    // The axis-parallel directions: axis, sign, and the signs of the two zero components.
+    using Kind = std::tuple<int, bool, bool, bool>;
+    const auto axis_kinds = [](const std::vector<Ray>& rs) {
+        std::set<Kind> kinds;
+        for (const Ray& r : rs)
+            for (int a = 0; a < 3; ++a)
+                if (r.dir[(a + 1) % 3] == 0.f && r.dir[(a + 2) % 3] == 0.f && r.dir[a] != 0.f && std::isfinite(r.dir[a]))
+                    kinds.insert({a, std::signbit(r.dir[a]), std::signbit(r.dir[(a + 1) % 3]),
+                                  std::signbit(r.dir[(a + 2) % 3])});
+        return kinds;
+    };
+    EXPECT_EQ(axis_kinds(rays).size(), 12u);
+    EXPECT_EQ(axis_kinds(sample), axis_kinds(rays));
+    EXPECT_GT(std::ranges::count_if(sample, [](const Ray& r) { return r.tnear > 0.f && !test::is_invalid(r); }), 0);
 }
 
 }  // namespace
