@@ -248,29 +248,34 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
     EXPECT_EQ(detail::batch_coherence({}), 1.f);
 }
 
-// The measured route. The first kPrior batches go by coherence, untimed; then, while it learns, runs
-// of kRun batches go to the paths in turn, all timed; then the path of least time per ray takes the
-// runs that are not timed, and a timed run goes to any path (the fastest too), fewer of them once the
-// choice is clear. `take(p, n, prior)` picks n batches and returns how many were timed, recording for
-// each timed one `per_ray[path]` seconds on a batch of `rays` rays.
+// The measured route. The first kPrior batches go by coherence, untimed; then, while it learns,
+// interleaved runs: kRounds rounds, each kPerPath batches per path, path after path, all but the
+// first of a path's batches timed; then the path of least time per ray takes the runs that are not
+// timed, and a timed run interleaves it with the paths near it, and with the far ones less often.
+// `take(n, prior)` picks n batches and returns how many were timed, recording for each timed one
+// `per_ray[path]` seconds per ray (times `tile_cost(batch)`, the batch's own cost, when given) on a
+// batch of `rays` rays.
 struct PickerRun {
     detail::RoutePicker& picker;
     std::vector<double> per_ray;
+    std::function<double(std::uint64_t)> tile_cost = [](std::uint64_t) { return 1.0; };
     int paths_seen[3] = {};
+    std::uint64_t batch = 0;
     int take(int n, int prior = 0, std::size_t rays = 100) {
         int timed = 0;
-        for (int i = 0; i < n; ++i) {
+        for (int i = 0; i < n; ++i, ++batch) {
             const detail::RoutePicker::Choice c = picker.pick(prior);
             ++paths_seen[c.path];
             if (!c.timed) continue;
             ++timed;
-            picker.record(c.path, per_ray[static_cast<std::size_t>(c.path)] * static_cast<double>(rays), rays);
+            picker.record(c.path, per_ray[static_cast<std::size_t>(c.path)] * tile_cost(batch) * static_cast<double>(rays),
+                          rays);
         }
         return timed;
     }
 };
 
-TEST(Routed, PickerLearnsInRunsThenTakesThePathOfLeastTimePerRay) {
+TEST(Routed, PickerLearnsInInterleavedRunsThenTakesThePathOfLeastTimePerRay) {
     using detail::RoutePicker;
     RoutePicker picker;
     for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) {  // coherence alone, nothing timed
@@ -278,29 +283,30 @@ TEST(Routed, PickerLearnsInRunsThenTakesThePathOfLeastTimePerRay) {
         EXPECT_EQ(c.path, static_cast<int>(i % 2));
         EXPECT_FALSE(c.timed);
     }
-    // Learning: runs of kRun consecutive batches, every batch timed; each block of two runs gives one
-    // to each path, in an order that varies from block to block.
-    std::vector<int> run_paths;
-    for (std::uint64_t run = 0; run < 2 * RoutePicker::kLearnRuns; ++run)
-        for (std::uint64_t i = 0; i < RoutePicker::kRun; ++i) {
-            const RoutePicker::Choice c = picker.pick(1);
-            if (i == 0) run_paths.push_back(c.path);
-            EXPECT_EQ(c.path, run_paths.back());
-            EXPECT_TRUE(c.timed);
-            // Batches of different sizes: per ray the packets take 3 units, the BVH 2.
-            const std::size_t rays = 32 + 7 * i;
-            picker.record(c.path, (c.path == 0 ? 3.0 : 2.0) * static_cast<double>(rays), rays);
-        }
-    int blocks_led_by[2] = {};
-    for (std::size_t b = 0; b + 1 < run_paths.size(); b += 2) {
-        EXPECT_NE(run_paths[b], run_paths[b + 1]);
-        ++blocks_led_by[run_paths[b]];
+    // Learning: each run kRounds rounds of kPerPath batches per path, in the same order in every
+    // round of the run, all but a path's first batch timed; the order varies from run to run.
+    constexpr std::uint64_t per = RoutePicker::kPerPath;
+    ASSERT_EQ(picker.run_length(), 2 * per * RoutePicker::kRounds);
+    int runs_led_by[2] = {};
+    for (std::uint64_t run = 0; run < RoutePicker::kLearnRuns; ++run) {
+        int first = -1;
+        for (std::uint64_t round = 0; round < RoutePicker::kRounds; ++round)
+            for (std::uint64_t i = 0; i < 2 * per; ++i) {
+                const RoutePicker::Choice c = picker.pick(1);
+                if (round == 0 && i == 0) first = c.path;
+                EXPECT_EQ(c.path, i < per ? first : 1 - first) << "run " << run << " round " << round << " batch " << i;
+                EXPECT_EQ(c.timed, i % per != 0) << "run " << run << " round " << round << " batch " << i;
+                // Batches of different sizes: per ray the packets take 3 units, the BVH 2.
+                const std::size_t rays = 32 + 7 * i;
+                if (c.timed) picker.record(c.path, (c.path == 0 ? 3.0 : 2.0) * static_cast<double>(rays), rays);
+            }
+        ++runs_led_by[first];
     }
-    EXPECT_GT(blocks_led_by[0], 0);
-    EXPECT_GT(blocks_led_by[1], 0);
+    EXPECT_GT(runs_led_by[0], 0);
+    EXPECT_GT(runs_led_by[1], 0);
     EXPECT_DOUBLE_EQ(picker.cost(0), 3.0);
     EXPECT_DOUBLE_EQ(picker.cost(1), 2.0);
-    EXPECT_EQ(picker.samples(0), RoutePicker::kLearnRuns * RoutePicker::kRun);
+    EXPECT_EQ(picker.samples(0), RoutePicker::kLearnRuns * RoutePicker::kRounds * (per - 1));
     // Known: the BVH, whatever the prior, except in the runs timed on the packets.
     PickerRun run{picker, {3.0, 2.0}};
     const int n = 8000;
@@ -315,16 +321,17 @@ TEST(Routed, PickerLearnsInRunsThenTakesThePathOfLeastTimePerRay) {
     EXPECT_EQ(picker.fastest(1), 0);
 }
 
-// With the streams, three paths, learned in turn; the cheapest per ray is taken.
+// With the streams, three paths, learned interleaved; the cheapest per ray is taken.
 TEST(Routed, PickerChoosesAmongThreePaths) {
     using detail::RoutePicker;
     RoutePicker picker(3);
     EXPECT_EQ(picker.paths(), 3);
     for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) EXPECT_EQ(picker.pick(1).path, 1);  // the prior
     PickerRun run{picker, {3.0, 2.0, 1.0}};
-    const auto learning = static_cast<int>(3 * RoutePicker::kLearnRuns * RoutePicker::kRun);
-    EXPECT_EQ(run.take(learning, 1), learning);
-    EXPECT_EQ(run.paths_seen[0], run.paths_seen[1]);  // by turns
+    const auto learning = static_cast<int>(RoutePicker::kLearnRuns * picker.run_length());
+    EXPECT_EQ(run.take(learning, 1), learning / static_cast<int>(RoutePicker::kPerPath) *
+                                         static_cast<int>(RoutePicker::kPerPath - 1));
+    EXPECT_EQ(run.paths_seen[0], run.paths_seen[1]);  // interleaved
     EXPECT_EQ(run.paths_seen[1], run.paths_seen[2]);
     EXPECT_EQ(picker.fastest(0), 2);
     EXPECT_EQ(picker.fastest(1), 2);
@@ -336,11 +343,10 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     EXPECT_FALSE(picker.far(0, 1));  // the packets within kFar of the single rays
     EXPECT_TRUE(picker.far(2, 1));
 
-    // A path with nothing counted (every batch of its runs a warm-up) is not chosen, and keeps the
+    // A path with nothing counted (no batch of it recorded) is not chosen, and keeps the
     // choice from being clear.
     RoutePicker half(3);
-    for (std::uint64_t i = 0; i < RoutePicker::kPrior + 3 * RoutePicker::kLearnRuns * RoutePicker::kRun; ++i)
-        half.pick(1);
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior + RoutePicker::kLearnRuns * half.run_length(); ++i) half.pick(1);
     half.record(0, 3.0, 1);
     half.record(1, 1.0, 1);
     EXPECT_EQ(half.cost(2), 0.0);
@@ -348,22 +354,50 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     EXPECT_FALSE(half.far(2, 1));
 }
 
-// Once the picker knows: one run in kSample is timed; a path within kFar of the fastest traces its
-// share of them, one that costs more than kFar times the fastest one in kSampleFar / kSample of
-// that share (the rest go to the fastest, timed).
+// A frame's tiles in order, where a tile on the object costs ten times one of background: the
+// object fills the middle columns of rows 4 to 11 of 16 x 16 tiles. The packets take 1.0 per ray,
+// the single rays 1.3, the streams 1.25. Every path is timed on tiles of the same stretches, so the
+// packets are taken; timed in runs of consecutive tiles, a path could see mostly the object where
+// another saw mostly background.
+TEST(Routed, PickerComparesPathsOnTheSameStretchesOfTiles) {
+    using detail::RoutePicker;
+    const auto tile_cost = [](std::uint64_t batch) {
+        const std::uint64_t tile = batch % 256, row = tile / 16, column = tile % 16;
+        return row >= 4 && row < 12 && column >= 5 && column < 11 ? 10.0 : 1.0;
+    };
+    for (const int paths : {2, 3}) {
+        RoutePicker picker(paths);
+        PickerRun run{picker, {1.0, 1.3, 1.25}, tile_cost};
+        run.take(6 * 256, 1);  // six frames
+        EXPECT_EQ(picker.fastest(1), 0) << paths << " paths: per ray packets " << picker.cost(0) << ", single rays "
+                                        << picker.cost(1) << ", streams " << picker.cost(2);
+        const int later = 4 * 256;
+        const int before = run.paths_seen[0];
+        run.take(later, 1);
+        EXPECT_GT(run.paths_seen[0] - before, later * 9 / 10) << paths << " paths";
+    }
+}
+
+// Once the picker knows: one run in kSample is timed; it interleaves the fastest with every path
+// within kFar of it, and with one that costs more than kFar times the fastest in kSampleFar /
+// kSample of them (in the others the fastest runs alone, timed, then takes the run's rest).
 TEST(Routed, PickerTimesFewRunsOnceItKnows) {
     using detail::RoutePicker;
-    const auto learning = static_cast<int>(RoutePicker::kPrior + 2 * RoutePicker::kLearnRuns * RoutePicker::kRun);
     RoutePicker close, clear;
+    const auto learning = static_cast<int>(RoutePicker::kPrior + RoutePicker::kLearnRuns * close.run_length());
     PickerRun near_run{close, {1.0, 1.2}}, far_run{clear, {1.0, 3.0}};
-    EXPECT_EQ(near_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
-    EXPECT_EQ(far_run.take(learning), learning - static_cast<int>(RoutePicker::kPrior));
+    const double rounds = RoutePicker::kRounds, per = RoutePicker::kPerPath, length = static_cast<double>(close.run_length());
+    const auto learned = static_cast<int>(RoutePicker::kLearnRuns * 2 * rounds * (per - 1));
+    EXPECT_EQ(near_run.take(learning), learned);
+    EXPECT_EQ(far_run.take(learning), learned);
     PickerRun near{close, {1.0, 1.2}}, far{clear, {1.0, 3.0}};
     const int n = 512000;
-    EXPECT_NEAR(near.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
-    EXPECT_NEAR(far.take(n), n / RoutePicker::kSample, n / RoutePicker::kSample / 4);
-    const int near_share = n / static_cast<int>(2 * RoutePicker::kSample);
-    const int far_share = n / static_cast<int>(2 * RoutePicker::kSampleFar);
+    const double timed_runs = n / length / RoutePicker::kSample, joined = 1.0 / (RoutePicker::kSampleFar / RoutePicker::kSample);
+    const double near_timed = timed_runs * 2 * rounds * (per - 1);
+    const double far_timed = timed_runs * ((1 - joined) + joined * 2) * rounds * (per - 1);
+    EXPECT_NEAR(near.take(n), near_timed, near_timed / 4);
+    EXPECT_NEAR(far.take(n), far_timed, far_timed / 4);
+    const double near_share = timed_runs * rounds * per, far_share = timed_runs * joined * rounds * per;
     EXPECT_NEAR(near.paths_seen[1], near_share, near_share / 4);
     EXPECT_NEAR(far.paths_seen[1], far_share, far_share / 4);
 }

@@ -26,38 +26,41 @@ const std::vector<std::string>& routed_traversals();
 // batches of that kind that were timed. Every path is exact, so the choice changes the time, never an
 // answer, and every batch is traced once.
 //
-// A path is timed over a run of kRun consecutive batches of the kind, not on one batch traced by two
-// paths: a path that traces a kind's batches keeps its nodes warm in the caches, and a path timed on
-// a single batch in between finds them cold. Paired samples of that kind chose wrong on three of
-// sixteen workloads with the streams (docs/INCOHERENT.md, "Ray streams"). In a run, a thread's batch
-// counts only when that thread's previous batch of the kind went on the same path (route()'s
-// warm-up), so every counted time is a warm one, as the chosen path's would be.
-//
-// Runs of neighbouring batches hold similar rays (a frame's tiles in order; a stream of bounces from
-// neighbouring pixels), but a background tile costs a tenth of one on the object: so while it learns,
-// the picker gives the runs to the paths in turn (each block of `paths` runs one to each path, in an
-// order drawn by a hash of the block), which spreads each path's runs over the same stretch of
-// batches, and a path's cost is its total time over its total rays.
+// Paths are timed in interleaved runs: kRounds rounds of consecutive batches, each round kPerPath
+// batches per path taking part, path after path in an order drawn by a hash of the run; a path's
+// first batch of its kPerPath warms its nodes and is not counted, the others are. Neighbouring
+// batches hold similar rays (a frame's tiles in order, a stream of bounces from neighbouring
+// pixels), and a tile of background costs a tenth of one on the object, so the paths of a run are
+// timed on short stretches of batches taken in turn from the same part of the workload. Timed in
+// runs of four batches given to each path in turn, eight runs each, the bunny's camera rays gave
+// the packets tiles 12 % dearer than the frame's mean and the single rays tiles 24 % cheaper, and
+// the route chose the streams, which take 1.4 to 1.5 times as long as the packets
+// (docs/INCOHERENT.md, "Fifth round"). The warm-up batch is there because the path that traces a
+// kind's batches keeps its nodes in the caches for the next batch, the packets of coherent rays
+// most: timed on single batches, path after path, the kd-tree's packets took 1.7 times their own
+// time per ray on Sponza's shadow rays; and two counted batches follow it, not one, because with
+// one the streams, whose rays fill the first-level cache, lost their lead on Sibenik's AO rays.
 //
 // The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
-// Python caller's one query, pays nothing for the choice. After kLearnRuns runs per path, the fastest
-// path takes every run but one in kSample, chosen by a hash of the run's number (not every n-th,
-// which would sample the same column of a frame's tiles); that run is timed on a path drawn by the
-// hash, the fastest included, so that every estimate keeps up with the workload. A path that costs
-// more than kFar times the fastest keeps only one in kSampleFar / kSample of the runs drawn for it
-// (the others go to the fastest, timed): a clear loser costs little, while two paths within kFar of
-// each other are both timed often. Times are the thread's CPU time, so a batch whose thread the
-// system preempted does not count the other threads' time. Sums are atomics: any number of threads
-// route and record at once, and a race only blurs a figure.
+// Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path; then
+// the fastest path takes every run but one in kSample, chosen by a hash of the run's number (not
+// every n-th, which would sample the same column of a frame's tiles); that run is timed with the
+// fastest and every path within kFar of it, and a path that costs more than kFar times the fastest
+// joins one in kSampleFar / kSample of them: a clear loser costs little, while two paths within kFar
+// of each other are compared often, on the same stretches. Times are the thread's CPU time, so a
+// batch whose thread the system preempted does not count the other threads' time. Sums are atomics:
+// any number of threads route and record at once, and a race only blurs a figure.
 class RoutePicker {
 public:
-    static constexpr std::uint64_t kPrior = 8, kRun = 4, kLearnRuns = 8, kSample = 16, kSampleFar = 64;
+    static constexpr std::uint64_t kPrior = 8, kRounds = 3, kPerPath = 3, kLearnRuns = 4, kSample = 16, kSampleFar = 64;
     static constexpr double kFar = 1.5;
     static constexpr int kMaxPaths = 3;
 
     explicit RoutePicker(int paths = 2) : paths_(paths < 2 ? 2 : (paths > kMaxPaths ? kMaxPaths : paths)) {}
 
     int paths() const { return paths_; }
+    // Batches per run: in each round, kPerPath per path.
+    std::uint64_t run_length() const { return kPerPath * kRounds * static_cast<std::uint64_t>(paths_); }
     // The batches counted for `path`, their time in seconds and their rays.
     std::uint64_t samples(int path) const { return samples_[path].load(std::memory_order_relaxed); }
     double seconds(int path) const { return seconds_[path].load(std::memory_order_relaxed); }
@@ -74,26 +77,34 @@ public:
     }
 
     struct Choice {
-        int path;           // 0: the packets, 1: the BVH's single rays, 2: the BVH's streams
-        bool timed;         // the batch belongs to a timed run: time it and record() it once warm
+        int path;    // 0: the packets, 1: the BVH's single rays, 2: the BVH's streams
+        bool timed;  // a counted batch (not the warm-up) of a timed run: time it and record() it
     };
 
     Choice pick(int prior) {
         const std::uint64_t n = batches_.fetch_add(1, std::memory_order_relaxed);
         if (n < kPrior) return {prior, false};
-        const std::uint64_t run = (n - kPrior) / kRun, paths = static_cast<std::uint64_t>(paths_);
-        if (run < kLearnRuns * paths) {
-            // Each block of `paths` runs gives one to every path, rotated by a hash of the block's
-            // number: in turn, but not in step with a frame's rows (two paths taking runs strictly
-            // by turns gave one the left half of every row of tiles and the other the right half).
-            return {static_cast<int>((run + mix(run / paths)) % paths), true};
-        }
-        const int fast = fastest(prior);
+        const std::uint64_t length = run_length(), run = (n - kPrior) / length, at = (n - kPrior) % length;
         const std::uint64_t h = mix(run);
-        if (h % kSample != 0) return {fast, false};
-        int path = static_cast<int>((h >> 16) % paths);
-        if (path != fast && far(path, fast) && (h >> 32) % (kSampleFar / kSample) != 0) path = fast;
-        return {path, true};
+        int in_run[kMaxPaths];
+        int k = 0;
+        if (run < kLearnRuns) {
+            for (int p = 0; p < paths_; ++p) in_run[k++] = p;
+        } else {
+            if (h % kSample != 0) return {fastest(prior), false};
+            const int fast = fastest(prior);
+            const bool far_ones_join = (h >> 32) % (kSampleFar / kSample) == 0;
+            for (int p = 0; p < paths_; ++p)
+                if (p == fast || !far(p, fast) || far_ones_join) in_run[k++] = p;
+        }
+        // The run's order: a rotation drawn by the hash, so that no path keeps the same columns of a
+        // frame's tiles from run to run. A round is kPerPath * k batches; with fewer paths than the
+        // run has room for, it is over sooner and the fastest takes the rest untimed.
+        const auto round_length = kPerPath * static_cast<std::uint64_t>(k);
+        const std::uint64_t round = at / round_length, slot = at % round_length;
+        if (round >= kRounds) return {fastest(prior), false};
+        const int path = in_run[(slot / kPerPath + (h >> 16)) % static_cast<std::uint64_t>(k)];
+        return {path, slot % kPerPath != 0};
     }
     // The path of least time per ray among those with counted batches; the prior while none has.
     int fastest(int prior) const {
@@ -104,7 +115,7 @@ public:
     }
     // Whether `path` costs more than kFar times `fast` (a path with nothing counted does not).
     bool far(int path, int fast) const { return cost(fast) > 0.0 && cost(path) > kFar * cost(fast); }
-    // A warm batch of a timed run: its path, its thread's CPU time and its rays.
+    // A counted batch of a timed run: its path, its thread's CPU time and its rays.
     void record(int path, double seconds, std::size_t rays) {
         add(seconds_[path], seconds);
         add(rays_[path], static_cast<double>(rays));
