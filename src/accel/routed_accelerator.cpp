@@ -81,12 +81,20 @@ private:
             count_rays(query, prior, rays.size());
             return trace(*paths_[prior], counters);
         }
-        const RoutePicker::Choice choice = pickers_[2 * query + prior].pick(prior);
+        const int kind = 2 * query + prior;
+        RoutePicker& picker = pickers_[kind];
+        const RoutePicker::Choice choice = picker.pick(prior);
         count_rays(query, choice.path, rays.size());
+        // The path of this thread's previous batch of the kind: a timed batch counts only when it is
+        // the same. On one thread a path's warm-up batch always comes right before; on several, the
+        // warm-up may have gone to another core, and this core's caches hold another path's nodes.
+        LastPath& last = last_path_[kind];
+        const bool warm = last.owner == this && last.path == choice.path;
+        last = {this, choice.path};
         if (!choice.timed) return trace(*paths_[choice.path], counters);
         const double start = thread_seconds();
         trace(*paths_[choice.path], counters);
-        pickers_[2 * query + prior].record(choice.path, thread_seconds() - start, rays.size());
+        if (warm) picker.record(choice.path, thread_seconds() - start, rays.size());
     }
 
     void count_rays(int query, int path, std::size_t n) const {
@@ -129,8 +137,16 @@ private:
     bool measured_;
     // One per kind of batch: closest or any hit, coherent or not.
     mutable std::array<RoutePicker, 4> pickers_;
+    // Per thread and kind of batch, the router and the path of the thread's last batch (route()).
+    struct LastPath {
+        const RoutedAccelerator* owner = nullptr;
+        int path = -1;
+    };
+    static thread_local std::array<LastPath, 4> last_path_;
     mutable std::atomic<std::uint64_t> routed_[2][3]{};  // rays answered, per query and path
 };
+
+thread_local std::array<RoutedAccelerator::LastPath, 4> RoutedAccelerator::last_path_;
 
 }  // namespace
 

@@ -40,6 +40,8 @@ const std::vector<std::string>& routed_traversals();
 // most: timed on single batches, path after path, the kd-tree's packets took 1.7 times their own
 // time per ray on Sponza's shadow rays; and two counted batches follow it, not one, because with
 // one the streams, whose rays fill the first-level cache, lost their lead on Sibenik's AO rays.
+// Several threads share a picker, so a run's batches go to whichever thread asks next; the router
+// counts a timed batch only when the same thread's previous batch of the kind took the same path.
 //
 // The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
 // Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path; then
