@@ -31,6 +31,7 @@
 
 #include "cellrt/accel.hpp"
 #include "cellrt/brute_force.hpp"
+#include "cellrt/ray.hpp"
 #include "sanitizers.hpp"
 
 namespace cellrt::test {
@@ -353,10 +354,8 @@ inline const ReferenceAnswers& cached_reference(const std::string& key, std::spa
 // each kind: with five, every axis-parallel ray along y would fall out.
 inline constexpr std::size_t kSanitizedStride = kSanitizers.empty() ? 1 : 7;
 
-inline bool is_invalid(const Ray& r) {
-    const auto finite = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    return !finite(r.org) || !finite(r.dir) || !std::isfinite(r.tnear) || dot(r.dir, r.dir) == 0.f || !(r.tnear <= r.tfar);
-}
+// The rays every kernel must answer as misses (cellrt::is_valid, cellrt/ray.hpp).
+inline bool is_invalid(const Ray& r) { return !is_valid(r); }
 
 inline bool in_sanitized_sample(std::size_t i, const Ray& r, std::size_t stride = kSanitizedStride) {
     return i % stride == 0 || is_invalid(r);

@@ -93,8 +93,8 @@ public:
         if (run < kLearnRuns) {
             for (int p = 0; p < paths_; ++p) in_run[k++] = p;
         } else {
-            if (h % kSample != 0) return {fastest(prior), false};
             const int fast = fastest(prior);
+            if (h % kSample != 0) return {fast, false};
             const bool far_ones_join = (h >> 32) % (kSampleFar / kSample) == 0;
             for (int p = 0; p < paths_; ++p)
                 if (p == fast || !far(p, fast) || far_ones_join) in_run[k++] = p;
