@@ -345,14 +345,15 @@ inline const ReferenceAnswers& cached_reference(const std::string& key, std::spa
     return *slot;
 }
 
-// The rays a sanitized test program traces of a suite (docs/RELIABILITY.md): every seventh, and every
-// invalid one (a few rays, each a case of its own). The sanitizers look for memory errors, races and
-// undefined behaviour on the kernels' paths, which a seventh of the suite still takes, at a seventh of
-// a cost 5 to 10 times the Release build's; the Release stage checks every answer. Seven is prime to
-// the periods the suite's rays repeat with (a tnear > 0 copy at every tenth index; axis-parallel
-// directions 12, edge points 4 and 3, axis planes 4 and 3, interval limits 4), so the sample keeps
-// each kind: with five, every axis-parallel ray along y would fall out.
-inline constexpr std::size_t kSanitizedStride = kSanitizers.empty() ? 1 : 7;
+// The rays a sanitized test program traces of a suite (docs/RELIABILITY.md): every thirteenth, and
+// every invalid one (a few rays, each a case of its own). The sanitizers look for memory errors, races
+// and undefined behaviour on the kernels' paths, which a thirteenth of the suite still takes, at a
+// thirteenth of a cost 5 to 10 times the Release build's; the Release stage checks every answer.
+// Thirteen is prime to the periods the suite's rays repeat with (a tnear > 0 copy at every tenth
+// index; axis-parallel directions 12, edge points 4 and 3, axis planes 4 and 3, interval limits 4),
+// so the sample keeps each kind: with five, every axis-parallel ray along y would fall out.
+inline constexpr std::size_t kSanitizedSampleStride = 13;
+inline constexpr std::size_t kSanitizedStride = kSanitizers.empty() ? 1 : kSanitizedSampleStride;
 
 // The rays every kernel must answer as misses (cellrt::is_valid, cellrt/ray.hpp).
 inline bool is_invalid(const Ray& r) { return !is_valid(r); }

@@ -40,18 +40,19 @@ TEST(Sanitizers, TbbRunsOnOneThreadOnlyUnderThreadSanitizer) {
     }
 }
 
-// The sanitized runs trace a seventh of each ray suite (test::sanitized_sample): every seventh ray and
+// The sanitized runs trace a thirteenth of each ray suite (test::sanitized_sample): every thirteenth ray and
 // every invalid one, so that each kind of ray the suite makes is still among them.
 TEST(Sanitizers, SuiteSampleKeepsEveryKindOfRay) {
-    EXPECT_EQ(test::kSanitizedStride, test::kSanitizers.empty() ? 1u : 7u);
+    constexpr std::size_t stride = test::kSanitizedSampleStride;
+    EXPECT_EQ(test::kSanitizedStride, test::kSanitizers.empty() ? 1u : stride);
     const std::vector<Ray> rays = test::RaySuite(test::cached_scene("builtin:spheres?tris=600").triangles,
                                                  test::small_suite()).rays();
-    const std::vector<Ray> sample = test::sanitized_sample(rays, 7);
+    const std::vector<Ray> sample = test::sanitized_sample(rays, stride);
     const auto invalid = [](const std::vector<Ray>& rs) { return std::ranges::count_if(rs, test::is_invalid); };
     EXPECT_EQ(invalid(rays), 7);
     EXPECT_EQ(invalid(sample), 7);
-    EXPECT_GE(sample.size(), rays.size() / 7);
-    EXPECT_LE(sample.size(), rays.size() / 7 + 1 + 7);
+    EXPECT_GE(sample.size(), rays.size() / stride);
+    EXPECT_LE(sample.size(), rays.size() / stride + 1 + 7);
     // The axis-parallel directions: axis, sign, and the signs of the two zero components.
     using Kind = std::tuple<int, bool, bool, bool>;
     const auto axis_kinds = [](const std::vector<Ray>& rs) {

@@ -128,7 +128,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, CoherentPackets,
                          });
 
 // The SIMD brute force computes every reference answer of these tests (it is fast); here it is held
-// to the scalar loop, the definition, on whole ray suites (a sanitized build: on a seventh of them,
+// to the scalar loop, the definition, on whole ray suites (a sanitized build: on a thirteenth of them,
 // test::sanitized_sample).
 TEST(BruteForcePackets, SameAnswersAsTheScalarLoop) {
     std::vector<std::pair<std::string, std::vector<Triangle>>> scenes = test::degenerate_scenes();
