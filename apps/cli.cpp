@@ -27,7 +27,8 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
     if (kind_optional) kind.clear();
     cmd.add_option("--accel", kind, "Acceleration structure: " + kinds)->capture_default_str();
     cmd.add_option("--traversal", traversal,
-                   "Single-ray traversal (kd: rec|branched|branchless, bih: branched|branchless); implies --simd off");
+                   "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|stream|packet); "
+                   "implies --simd off");
     simd_option = cmd.add_option("--simd", simd,
                                  "SIMD ray packets: auto|off|portable|sse|avx2|avx512 (docs/PACKETS.md)")
                       ->capture_default_str();

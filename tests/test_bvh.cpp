@@ -150,35 +150,40 @@ TEST(Bvh, RaysAlongItsOwnBoxFaces) {
     }
     const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
     test::expect_matches(*make_accelerator(scene.triangles, bvh()), ref, "bvh on its box faces");
-    test::expect_matches(*make_accelerator(scene.triangles, parse_accel_config("bvh:stream")), ref,
-                         "bvh:stream on its box faces");
+    for (const char* config : {"bvh:stream", "bvh:packet"})
+        test::expect_matches(*make_accelerator(scene.triangles, parse_accel_config(config)), ref,
+                             std::string(config) + " on its box faces");
 }
 
-// The stream traversal on batches of every size, from one ray to the whole suite in one call (the
-// per-thread scratch grows and is reused), with invalid rays mixed in: the brute-force answers, and
-// every ray counted once.
-TEST(Bvh, StreamsOfAnySizeMatchBruteForce) {
+// The stream and packet traversals on batches of every size, from one ray to the whole suite in one
+// call (the per-thread scratch grows and is reused; packets of eight rays and a short last one), with
+// invalid rays mixed in: the brute-force answers, and every ray counted once.
+TEST(Bvh, StreamsAndPacketsOfAnySizeMatchBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& suite = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
-    std::vector<Ray> rays = suite.rays;
+    std::vector<Ray> rays = test::sanitized_sample(suite.rays);
     for (std::size_t i = 0; i < rays.size(); i += 97) rays[i].dir = {0.f, 0.f, 0.f};  // invalid: no hit
     const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
-    const auto stream = make_accelerator(scene.triangles, parse_accel_config("bvh:stream"));
-    EXPECT_EQ(stream->stats().traversal, "stream");
-    for (std::size_t batch : {std::size_t{1}, std::size_t{7}, std::size_t{256}, std::size_t{1000}, rays.size()}) {
-        std::vector<Hit> hits(rays.size());
-        std::vector<std::uint8_t> occluded(rays.size(), 2);
-        TraversalCounters counters;
-        for (std::size_t i = 0; i < rays.size(); i += batch) {
-            const std::size_t n = std::min(batch, rays.size() - i);
-            stream->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n), &counters);
-            stream->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
+    for (const char* traversal : {"stream", "packet"}) {
+        const auto accel = make_accelerator(scene.triangles, parse_accel_config(std::string("bvh:") + traversal));
+        EXPECT_EQ(accel->stats().traversal, traversal);
+        for (std::size_t batch : {std::size_t{1}, std::size_t{7}, std::size_t{9}, std::size_t{256}, std::size_t{1000},
+                                  rays.size()}) {
+            std::vector<Hit> hits(rays.size());
+            std::vector<std::uint8_t> occluded(rays.size(), 2);
+            TraversalCounters counters;
+            for (std::size_t i = 0; i < rays.size(); i += batch) {
+                const std::size_t n = std::min(batch, rays.size() - i);
+                accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n), &counters);
+                accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
+            }
+            std::size_t bad = 0;
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
+            EXPECT_EQ(bad, 0u) << traversal << ", batches of " << batch;
+            EXPECT_EQ(counters.rays, rays.size());
+            EXPECT_GT(counters.nodes, 0u);
         }
-        std::size_t bad = 0;
-        for (std::size_t i = 0; i < rays.size(); ++i) bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
-        EXPECT_EQ(bad, 0u) << "batches of " << batch;
-        EXPECT_EQ(counters.rays, rays.size());
-        EXPECT_GT(counters.nodes, 0u);
     }
 }
 

@@ -7,11 +7,19 @@
 namespace cellrt {
 namespace {
 
+// The traversals, in the order of bvh_traversals().
+enum class Traversal { wide, stream, packet };
+
+Traversal traversal_named(const std::string& name) {
+    const std::string& chosen = detail::choose_traversal(bvh_traversals(), name, "bvh");
+    return chosen == "stream" ? Traversal::stream : chosen == "packet" ? Traversal::packet : Traversal::wide;
+}
+
 class BvhAccelerator final : public Accelerator {
 public:
     BvhAccelerator(std::span<const Triangle> triangles, const detail::BvhBuildOptions& options,
-                   const detail::BvhKernels& kernels, bool stream)
-        : options_(options), kernels_(kernels), stream_(stream), triangle_count_(triangles.size()) {
+                   const detail::BvhKernels& kernels, Traversal traversal)
+        : options_(options), kernels_(kernels), traversal_(traversal), triangle_count_(triangles.size()) {
         const Timer timer;
         tree_ = detail::build_bvh(triangles, options);
         build_seconds_ = timer.seconds();
@@ -19,14 +27,14 @@ public:
     }
 
     // A view of `other`'s tree traced by the given traversal (bvh_with_traversal).
-    BvhAccelerator(const BvhAccelerator& other, bool stream)
-        : options_(other.options_), kernels_(other.kernels_), stream_(stream), triangle_count_(other.triangle_count_),
+    BvhAccelerator(const BvhAccelerator& other, Traversal traversal)
+        : options_(other.options_), kernels_(other.kernels_), traversal_(traversal), triangle_count_(other.triangle_count_),
           shared_(&other.tree()) {}
 
     AccelStats stats() const override {
         AccelStats s;
         s.name = "bvh";
-        s.traversal = stream_ ? "stream" : "wide";
+        s.traversal = bvh_traversals()[static_cast<std::size_t>(traversal_)];
         s.build_seconds = build_seconds_;
         s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = tree().nodes.size() * sizeof(detail::BvhNode) + tree().leaves.size() * sizeof(detail::BvhLeaf);
@@ -51,18 +59,22 @@ public:
 
 private:
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        (stream_ ? kernels_.stream_closest : kernels_.closest)(tree(), rays, hits, counters);
+        (traversal_ == Traversal::stream   ? kernels_.stream_closest
+         : traversal_ == Traversal::packet ? kernels_.packet_closest
+                                           : kernels_.closest)(tree(), rays, hits, counters);
     }
     void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                      TraversalCounters* counters) const override {
-        (stream_ ? kernels_.stream_any : kernels_.any)(tree(), rays, occluded, counters);
+        (traversal_ == Traversal::stream   ? kernels_.stream_any
+         : traversal_ == Traversal::packet ? kernels_.packet_any
+                                           : kernels_.any)(tree(), rays, occluded, counters);
     }
 
     const detail::BvhTree& tree() const { return shared_ ? *shared_ : tree_; }
 
     detail::BvhBuildOptions options_;
     const detail::BvhKernels& kernels_;
-    bool stream_;  // the stream traversal, not single rays
+    Traversal traversal_;
     std::size_t triangle_count_;
     detail::BvhTree tree_;
     const detail::BvhTree* shared_ = nullptr;  // a view's tree, owned by the accelerator it was made from
@@ -74,8 +86,7 @@ private:
 std::unique_ptr<Accelerator> detail::bvh_with_traversal(const Accelerator& bvh, const std::string& traversal) {
     const auto* b = dynamic_cast<const BvhAccelerator*>(&bvh);
     if (!b) throw Error("bvh_with_traversal: not a wide BVH");
-    const bool stream = detail::choose_traversal(bvh_traversals(), traversal, "bvh") == "stream";
-    return std::unique_ptr<Accelerator>(new BvhAccelerator(*b, stream));
+    return std::unique_ptr<Accelerator>(new BvhAccelerator(*b, traversal_named(traversal)));
 }
 
 const ParamTable& bvh_params() {
@@ -93,7 +104,7 @@ const ParamTable& bvh_params() {
 // A function's static, not a namespace-scope one: the registry copies the list when it is first used,
 // which may be during another unit's static initialisation (a test's list of configurations).
 const std::vector<std::string>& bvh_traversals() {
-    static const std::vector<std::string> names{"wide", "stream"};
+    static const std::vector<std::string> names{"wide", "stream", "packet"};
     return names;
 }
 
@@ -106,8 +117,7 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.traversal_cost = params.number("traversal_cost");
     options.intersection_cost = params.number("intersection_cost");
     params.finish();
-    const bool stream = detail::choose_traversal(bvh_traversals(), config.traversal, "bvh") == "stream";
-    return std::make_unique<BvhAccelerator>(triangles, options, kernels, stream);
+    return std::make_unique<BvhAccelerator>(triangles, options, kernels, traversal_named(config.traversal));
 }
 
 }  // namespace cellrt

@@ -21,6 +21,9 @@ struct BvhKernels {
     // The stream traversal (bvh_stream.inl): the batch's rays down the tree together.
     void (*stream_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*stream_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+    // The packet traversal (bvh_packet.inl): eight consecutive rays of the batch, one per lane.
+    void (*packet_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*packet_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
     const char* isa;  // the instruction set they are compiled for
 };
 

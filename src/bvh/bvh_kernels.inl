@@ -293,8 +293,20 @@ inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<
 }
 
 #include "bvh/bvh_stream.inl"
+#include "bvh/bvh_packet.inl"
+
+inline void closest_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
+                                 TraversalCounters* counters) {
+    packet_batch<ClosestHit>(tree, rays, hits, counters);
+}
+
+inline void any_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                             TraversalCounters* counters) {
+    packet_batch<AnyHit>(tree, rays, occluded, counters);
+}
 
 inline const BvhKernels& bvh_kernels(const char* isa) {
-    static const BvhKernels k{&closest_batch, &any_batch, &closest_stream_batch, &any_stream_batch, isa};
+    static const BvhKernels k{&closest_batch,        &any_batch,        &closest_stream_batch, &any_stream_batch,
+                              &closest_packet_batch, &any_packet_batch, isa};
     return k;
 }

@@ -1,0 +1,188 @@
+// Packets of rays over the wide BVH (issue 18; after Wald, Benthin, Boulos 2008, "Getting Rid of
+// Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8): eight consecutive rays
+// of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
+// against the packet's rays at once, giving the rays that meet it; the packet goes on to the children
+// some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
+// query: the first met), the others waiting on one stack. So a coherent packet reads each node, pops
+// the stack and takes each branch once for its eight rays, where single rays (bvh_kernels.inl) do it
+// once per ray; the arithmetic is the same. When one ray is left on a branch it goes on alone, with
+// the single-ray kernel, from the node it reached (kPacketSingleBelow).
+//
+// Exact: a ray's box test is meet_children's, lane for lane (the same operations in the same order,
+// the plane it enters and leaves by chosen by its own direction's signs), and its leaves are tested
+// by test_leaf with its own query. A ray therefore reaches a leaf only if it meets every box on the
+// way, and then tests it as its own kernel would; a waiting branch is dropped for a ray only when
+// the ray's best hit is nearer than the branch's entry minus the margin, when its own kernel would
+// drop it too. The hit rule picks the same answer whatever the order, so the answers are brute
+// force's.
+//
+// No include guard: included after bvh_kernels.inl in each instruction set's namespace.
+
+// Rays per packet: one per lane.
+inline constexpr int kPacketRays = kLanes;
+// A branch that this many rays of a packet or fewer go down is traced by each ray alone (the
+// single-ray kernel), as Embree's hybrid traversal falls back to single rays when few lanes are left.
+inline constexpr int kPacketSingleBelow = 1;
+
+// A packet's rays as the box tests read them, one ray per lane.
+struct PacketRays {
+    F org[3], inv[3];
+    I negative[3];  // lanes whose direction's sign bit is set on that axis: they enter a box by its hi plane
+    F tnear, margin;
+};
+
+// The packet's rays that meet child `k` of `node` within [tnear - margin, cull], as lane bits, with
+// each one's entry distance: meet_children's test of that child, in every ray's lane.
+inline unsigned packet_meets(const BvhNode& node, int k, const PacketRays& p, F cull, F& entry) {
+    F enter = p.tnear, leave = splat(kInfinity);
+    for (int a = 0; a < 3; ++a) {
+        const F to_lo = (splat(node.lo[a][k]) - p.org[a]) * p.inv[a];
+        const F to_hi = (splat(node.hi[a][k]) - p.org[a]) * p.inv[a];
+        enter = max_keep(enter, select(p.negative[a], to_hi, to_lo));
+        leave = min_keep(leave, select(p.negative[a], to_lo, to_hi));
+    }
+    entry = enter - p.margin;
+    return bits(entry <= min_keep(cull, leave + p.margin));
+}
+
+// A branch waiting on the packet's stack: the node's word, its rays (lane bits) and their smallest entry.
+struct PacketFrame {
+    std::uint32_t word;
+    unsigned rays;
+    float entry;
+};
+
+// One packet through the tree. `rays` holds the lanes of valid rays; each lane's query, its
+// TraversalRay (for the single-ray kernel) and its LeafRay are at that index of the arrays. Returns
+// the rays of `rays` not answered: an any-hit query's misses.
+template <class Query, class Counters>
+unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const PacketRays& p, const TraversalRay* single,
+                  const LeafRay* leaf_rays, Query* q, unsigned rays, Counters& c) {
+    constexpr bool kAny = Query::kAnyHit;
+    F cull;
+    for (int i = 0; i < kPacketRays; ++i) cull[i] = rays >> i & 1 ? q[i].cull_t() : -kInfinity;
+    unsigned active = rays;  // any hit: the rays not answered yet
+    PacketFrame stack[kBvhStackSize + kBvhStackSlack];
+    int size = 0;
+    std::uint32_t word = 0;
+    unsigned mask = rays;
+    for (;;) {
+        if (__builtin_popcount(mask) > kPacketSingleBelow) {
+            if (BvhNode::is_leaf(word)) {
+                const BvhLeaf& leaf = leaves[BvhNode::leaf_index(word)];
+                const std::uint32_t count = BvhNode::leaf_count(word);
+                for (unsigned m = mask; m; m &= m - 1) {
+                    const int i = __builtin_ctz(m);
+                    if (test_leaf(leaf, count, leaf_rays[i], q[i], c)) active &= ~(1u << i);
+                    if constexpr (!kAny) cull[i] = q[i].cull_t();
+                }
+            } else {
+                const BvhNode& node = nodes[word];
+                for (unsigned m = mask; m; m &= m - 1) c.node();
+                const I words = reinterpret_cast<I>(load_u(node.child));
+                unsigned children = bits(words != splat_i(-1));  // kEmptyChild: no box
+                unsigned met = 0, next = 0;
+                unsigned child_rays[kBvhWidth];
+                float key[kBvhWidth];
+                float nearest = kInfinity;
+                for (; children; children &= children - 1) {
+                    const int k = __builtin_ctz(children);
+                    F entry;
+                    const unsigned m = packet_meets(node, k, p, cull, entry) & mask;
+                    if (!m) continue;
+                    child_rays[k] = m;
+                    if constexpr (kAny) {
+                        if (!met) next = static_cast<unsigned>(k);
+                    } else {
+                        key[k] = horizontal_min(select(met_mask(m), entry, splat(kInfinity)));
+                        if (!met || key[k] < nearest) nearest = key[k], next = static_cast<unsigned>(k);
+                    }
+                    met |= 1u << k;
+                }
+                if (met) {
+                    for (unsigned rest = met & ~(1u << next); rest; rest &= rest - 1) {
+                        const int k = __builtin_ctz(rest);
+                        stack[size++] = {node.child[k], child_rays[k], kAny ? 0.f : key[k]};
+                    }
+                    word = node.child[next];
+                    mask = child_rays[next];
+                    continue;
+                }
+            }
+        } else {
+            // Few rays left on this branch: each goes on with its own kernel from here.
+            for (unsigned m = mask; m; m &= m - 1) {
+                const int i = __builtin_ctz(m);
+                if (traverse_bvh_from(nodes, leaves, BoxRay(single[i]), leaf_rays[i], word, q[i], c))
+                    active &= ~(1u << i);
+                if constexpr (!kAny) cull[i] = q[i].cull_t();
+            }
+        }
+        // The next waiting branch with a ray that still needs it: not answered (any hit), or whose
+        // best hit is not nearer than the branch's nearest entry minus the margin (closest hit).
+        for (;;) {
+            if (size == 0) return active;
+            const PacketFrame& f = stack[--size];
+            mask = f.rays & active;
+            if constexpr (!kAny) mask &= bits(splat(f.entry) <= cull);
+            if (mask) {
+                word = f.word;
+                break;
+            }
+        }
+    }
+}
+
+// A ray that stands in for an invalid one in its lane (whose answer is a miss): any finite ray.
+inline Ray packet_placeholder_ray() { return Ray{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f}; }
+
+// The batch in packets of kPacketRays consecutive rays (the last may be short); invalid rays
+// (ray.hpp) answer misses.
+template <class Query, class Answer>
+void packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Answer> out, TraversalCounters* counters) {
+    if (tree.nodes.empty()) return miss_all(rays, out, counters);
+    with_counters(counters, rays.size(), [&](auto& count) {
+        for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
+            const std::size_t n = std::min<std::size_t>(kPacketRays, rays.size() - first);
+            unsigned valid = 0;
+            const auto ray = [&](std::size_t i) -> Ray {
+                if (i < n && is_valid(rays[first + i])) {
+                    valid |= 1u << i;
+                    return rays[first + i];
+                }
+                return packet_placeholder_ray();
+            };
+            const auto make = [&]<std::size_t... L>(std::index_sequence<L...>) {
+                return std::array<TraversalRay, kPacketRays>{TraversalRay(ray(L), tree.bounds)...};
+            };
+            const std::array<TraversalRay, kPacketRays> single = make(std::make_index_sequence<kPacketRays>());
+            const auto leaf = [&]<std::size_t... L>(std::index_sequence<L...>) {
+                return std::array<LeafRay, kPacketRays>{LeafRay(single[L].watertight)...};
+            };
+            const std::array<LeafRay, kPacketRays> leaf_rays = leaf(std::make_index_sequence<kPacketRays>());
+            const auto query = [&]<std::size_t... L>(std::index_sequence<L...>) {
+                return std::array<Query, kPacketRays>{Query(single[L])...};
+            };
+            std::array<Query, kPacketRays> q = query(std::make_index_sequence<kPacketRays>());
+            PacketRays p{};
+            for (int i = 0; i < kPacketRays; ++i) {
+                const TraversalRay& r = single[static_cast<std::size_t>(i)];
+                for (int a = 0; a < 3; ++a) {
+                    p.org[a][i] = r.org[a];
+                    p.inv[a][i] = r.inv_dir[a];
+                    p.negative[a][i] = r.dir_neg[a] ? -1 : 0;
+                }
+                p.tnear[i] = r.tnear;
+                p.margin[i] = r.margin;
+            }
+            const unsigned missed =
+                valid ? trace_packet(tree.nodes.data(), tree.leaves.data(), p, single.data(), leaf_rays.data(),
+                                     q.data(), valid, count)
+                      : 0u;
+            for (std::size_t i = 0; i < n; ++i) {
+                if constexpr (Query::kAnyHit) out[first + i] = (valid & ~missed) >> i & 1;
+                else out[first + i] = valid >> i & 1 ? q[i].result() : Hit{};
+            }
+        }
+    });
+}
