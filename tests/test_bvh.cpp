@@ -264,7 +264,7 @@ struct PickerRun {
     detail::RoutePicker& picker;
     std::vector<double> per_ray;
     std::function<double(std::uint64_t)> tile_cost = [](std::uint64_t) { return 1.0; };
-    int paths_seen[3] = {};
+    int paths_seen[detail::RoutePicker::kMaxPaths] = {};
     std::uint64_t batch = 0;
     int take(int n, int prior = 0, std::size_t rays = 100) {
         int timed = 0;
@@ -361,7 +361,7 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
 
 // A frame's tiles in order, where a tile on the object costs ten times one of background: the
 // object fills the middle columns of rows 4 to 11 of 16 x 16 tiles. The packets take 1.0 per ray,
-// the single rays 1.3, the streams 1.25. Every path is timed on tiles of the same stretches, so the
+// the single rays 1.3, the streams 1.25, the BVH's packets 1.15. Every path is timed on tiles of the same stretches, so the
 // packets are taken; timed in runs of consecutive tiles, a path could see mostly the object where
 // another saw mostly background.
 TEST(Routed, PickerComparesPathsOnTheSameStretchesOfTiles) {
@@ -370,9 +370,9 @@ TEST(Routed, PickerComparesPathsOnTheSameStretchesOfTiles) {
         const std::uint64_t tile = batch % 256, row = tile / 16, column = tile % 16;
         return row >= 4 && row < 12 && column >= 5 && column < 11 ? 10.0 : 1.0;
     };
-    for (const int paths : {2, 3}) {
+    for (const int paths : {2, 3, 4}) {
         RoutePicker picker(paths);
-        PickerRun run{picker, {1.0, 1.3, 1.25}, tile_cost};
+        PickerRun run{picker, {1.0, 1.3, 1.25, 1.15}, tile_cost};
         run.take(6 * 256, 1);  // six frames
         EXPECT_EQ(picker.fastest(1), 0) << paths << " paths: per ray packets " << picker.cost(0) << ", single rays "
                                         << picker.cost(1) << ", streams " << picker.cost(2);
@@ -424,20 +424,24 @@ TEST(Routed, MeasuredRouteCountsOneTracingPerRay) {
     EXPECT_EQ(counters.rays, frame.primary.size());
 }
 
-// The three paths by name: `auto` holds the streams unless told not to, and only when it measures
-// (coherence alone never names them).
-TEST(Routed, StreamsAreAThirdPathOfTheMeasuredRoute) {
+// The paths by name: `auto` holds the BVH's streams and packets unless told not to, and only when it
+// measures (coherence alone never names them).
+TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
-    auto streams = [&](const std::string& spec) {
-        return make_accelerator(scene.triangles, parse_accel_config(spec))->stats().setting("streams").value_or("");
+    auto setting = [&](const std::string& spec, const std::string& name) {
+        return make_accelerator(scene.triangles, parse_accel_config(spec))->stats().setting(name).value_or("");
     };
-    EXPECT_EQ(streams("auto"), "on");
-    EXPECT_EQ(streams("auto@streams=off"), "off");
-    EXPECT_EQ(streams("auto@route=coherence"), "off");
-    EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@streams=maybe")), Error);
+    for (const std::string name : {"streams", "bvh_packets"}) {
+        EXPECT_EQ(setting("auto", name), "on");
+        EXPECT_EQ(setting("auto@" + name + "=off", name), "off");
+        EXPECT_EQ(setting("auto@route=coherence", name), "off");
+        EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@" + name + "=maybe")), Error);
+    }
+    EXPECT_EQ(setting("auto@streams=off", "bvh_packets"), "on");
+    EXPECT_EQ(setting("auto@bvh_packets=off", "streams"), "on");
 }
 
-// While it learns, the route gives runs of batches to each of the three paths, with the same
+// While it learns, the route gives runs of batches to each of the four paths, with the same
 // answers, and the work counted is one tracing per ray whichever path answered.
 TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
@@ -456,9 +460,9 @@ TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
         EXPECT_EQ(occluded, ref.occluded);
         EXPECT_EQ(counters.rays, ref.rays.size());
     }
-    // Each path answered some of them: "closest packets P single S stream T; any ...".
+    // Each path answered some of them: "closest packets P single S stream T bvh-packets B; any ...".
     const std::string routes = routed->stats().setting("routed").value_or("");
-    for (const char* path : {" packets ", " single ", " stream "}) {
+    for (const char* path : {" packets ", " single ", " stream ", " bvh-packets "}) {
         const std::size_t at = routes.find(path);
         ASSERT_NE(at, std::string::npos) << routes;
         EXPECT_GT(std::stod(routes.substr(at + std::string(path).size())), 0.0) << path << "in: " << routes;

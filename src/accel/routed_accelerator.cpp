@@ -8,6 +8,7 @@
 #include <ctime>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "bvh/bvh_accel.hpp"
 #include "cellrt/accel.hpp"
@@ -31,29 +32,36 @@ double thread_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// A path of the route: its name in the report, and what traces it.
+struct RoutePath {
+    const char* name;
+    std::unique_ptr<Accelerator> accel;
+};
+
 class RoutedAccelerator final : public Accelerator {
 public:
-    // `stream`, when given, traces `incoherent`'s tree as streams (bvh_with_traversal): a third path.
-    RoutedAccelerator(std::unique_ptr<Accelerator> coherent, std::unique_ptr<Accelerator> incoherent,
-                      std::unique_ptr<Accelerator> stream, float threshold, std::string packets, bool measured)
-        : paths_{std::move(coherent), std::move(incoherent), std::move(stream)}, count_(paths_[2] ? 3 : 2),
-          threshold_(threshold), packets_(std::move(packets)), measured_(measured),
+    // paths[0] is the tree's packets and paths[1] the BVH's single rays (coherence names one of them);
+    // the measured route may hold views of the BVH's tree traced otherwise (bvh_with_traversal) after them.
+    RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
+        : paths_(std::move(paths)), count_(static_cast<int>(paths_.size())), threshold_(threshold),
+          packets_(std::move(packets)), measured_(measured),
           pickers_{RoutePicker(count_), RoutePicker(count_), RoutePicker(count_), RoutePicker(count_)} {}
 
     AccelStats stats() const override {
-        const AccelStats c = paths_[0]->stats(), i = paths_[1]->stats();
+        const AccelStats c = paths_[0].accel->stats(), i = paths_[1].accel->stats();
         AccelStats s;
         s.name = "auto";
         s.traversal = "auto";
         s.simd_lanes = c.simd_lanes;
         s.build_seconds = c.build_seconds + i.build_seconds;
         s.build_cpu_seconds = c.build_cpu_seconds + i.build_cpu_seconds;
-        s.memory_bytes = c.memory_bytes + i.memory_bytes;  // the streams trace the BVH's own tree
+        s.memory_bytes = c.memory_bytes + i.memory_bytes;  // the other paths trace the BVH's own tree
         s.triangles = c.triangles;
         s.settings = {{"packets", packets_},
                       {"coherence", param_number(threshold_)},
                       {"route", measured_ ? "measured" : "coherence"},
-                      {"streams", paths_[2] ? "on" : "off"},
+                      {"streams", holds("stream") ? "on" : "off"},
+                      {"bvh_packets", holds("bvh-packets") ? "on" : "off"},
                       {"routed", routed()}};
         return s;
     }
@@ -79,7 +87,7 @@ private:
         const int prior = batch_coherence(rays) >= threshold_ ? 0 : 1;
         if (!measured_ || rays.size() < kMeasuredBatch) {
             count_rays(query, prior, rays.size());
-            return trace(*paths_[prior], counters);
+            return trace(*paths_[prior].accel, counters);
         }
         const int kind = 2 * query + prior;
         RoutePicker& picker = pickers_[kind];
@@ -91,27 +99,28 @@ private:
         LastPath& last = last_path_[kind];
         const bool warm = last.owner == this && last.path == choice.path;
         last = {this, choice.path};
-        if (!choice.timed) return trace(*paths_[choice.path], counters);
+        if (!choice.timed) return trace(*paths_[choice.path].accel, counters);
         const double start = thread_seconds();
-        trace(*paths_[choice.path], counters);
+        trace(*paths_[choice.path].accel, counters);
         if (warm) picker.record(choice.path, thread_seconds() - start, rays.size());
     }
 
     void count_rays(int query, int path, std::size_t n) const {
         routed_[query][path].fetch_add(n, std::memory_order_relaxed);
     }
-    // Which path answered how many rays so far, per query: "closest packets/single/stream, any ..."
-    // as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
+    // Which path answered how many rays so far, per query: "closest packets/single/stream/bvh-packets,
+    // any ..." as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
     // was timed, the batches counted and each path's time per ray in nanoseconds (0: none counted).
     std::string routed() const {
         std::string out;
         for (int q = 0; q < 2; ++q) {
-            double n[3], sum = 0.0;
-            for (int p = 0; p < 3; ++p) sum += n[p] = static_cast<double>(routed_[q][p].load(std::memory_order_relaxed));
+            double n[RoutePicker::kMaxPaths], sum = 0.0;
+            for (int p = 0; p < count_; ++p)
+                sum += n[p] = static_cast<double>(routed_[q][p].load(std::memory_order_relaxed));
             out += q ? "; any" : "closest";
             for (int p = 0; p < count_; ++p) {
                 char buf[48];
-                std::snprintf(buf, sizeof buf, " %s %.2f", kPathNames[p], sum > 0.0 ? n[p] / sum : 0.0);
+                std::snprintf(buf, sizeof buf, " %s %.2f", paths_[p].name, sum > 0.0 ? n[p] / sum : 0.0);
                 out += buf;
             }
         }
@@ -122,16 +131,18 @@ private:
             out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) + " batches), ns per ray";
             for (int p = 0; p < count_; ++p) {
                 char buf[48];
-                std::snprintf(buf, sizeof buf, " %s %.1f", kPathNames[p], 1e9 * picker.cost(p));
+                std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p));
                 out += buf;
             }
         }
         return out;
     }
-    static constexpr const char* kPathNames[3] = {"packets", "single", "stream"};
+    bool holds(const std::string& name) const {
+        return std::ranges::any_of(paths_, [&](const RoutePath& p) { return name == p.name; });
+    }
 
-    std::unique_ptr<Accelerator> paths_[3];  // the packets, the BVH's single rays, its streams (or null)
-    int count_;                              // paths in use: 2, or 3 with streams
+    std::vector<RoutePath> paths_;
+    int count_;  // paths_.size()
     float threshold_;
     std::string packets_;
     bool measured_;
@@ -143,7 +154,7 @@ private:
         int path = -1;
     };
     static thread_local std::array<LastPath, 4> last_path_;
-    mutable std::atomic<std::uint64_t> routed_[2][3]{};  // rays answered, per query and path
+    mutable std::atomic<std::uint64_t> routed_[2][RoutePicker::kMaxPaths]{};  // rays answered, per query and path
 };
 
 thread_local std::array<RoutedAccelerator::LastPath, 4> RoutedAccelerator::last_path_;
@@ -180,9 +191,11 @@ const ParamTable& routed_params() {
          "the least time per ray over runs of such batches given to each path in turn; coherence: by "
          "coherence alone, the same path (and work counts) in every run"},
         {"streams", choice, "on", 0, 0, {"on", "off"},
-         "on: the measured route also times the wide BVH's stream traversal (bvh:stream) as a third path "
-         "and takes it for the kinds of batch it traces fastest (AO and many bounces); off: packets and "
-         "single rays only"},
+         "on: the measured route also times the wide BVH's stream traversal (bvh:stream) as a path and "
+         "takes it for the kinds of batch it traces fastest (AO and many bounces); off: not"},
+        {"bvh_packets", choice, "on", 0, 0, {"on", "off"},
+         "on: the measured route also times the wide BVH's packet traversal (bvh:packet) as a path and "
+         "takes it for the kinds of batch it traces fastest; off: not"},
     };
     return table;
 }
@@ -195,6 +208,7 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     const auto threshold = static_cast<float>(params.number("coherence"));
     const bool measured = params.choice("route") == "measured";
     const bool streams = params.choice("streams") == "on";
+    const bool bvh_packets = params.choice("bvh_packets") == "on";
     params.finish();
     choose_traversal(kTraversals, config.traversal, "auto");
     AccelConfig part;
@@ -211,10 +225,15 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     part.kind = "bvh";
     part.params.clear();
     std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, part);
-    // Coherence alone never names the streams, so only the measured route holds them.
-    std::unique_ptr<Accelerator> stream = streams && measured ? bvh_with_traversal(*bvh, "stream") : nullptr;
-    return std::make_unique<RoutedAccelerator>(std::move(coherent), std::move(bvh), std::move(stream), threshold,
-                                               packets, measured);
+    std::vector<RoutePath> paths;
+    paths.push_back({"packets", std::move(coherent)});
+    const Accelerator& tree_of_bvh = *bvh;
+    paths.push_back({"single", std::move(bvh)});
+    // Coherence alone names neither the streams nor the BVH's packets, so only the measured route
+    // holds them: views of the BVH's tree, not further builds.
+    if (streams && measured) paths.push_back({"stream", bvh_with_traversal(tree_of_bvh, "stream")});
+    if (bvh_packets && measured) paths.push_back({"bvh-packets", bvh_with_traversal(tree_of_bvh, "packet")});
+    return std::make_unique<RoutedAccelerator>(std::move(paths), threshold, packets, measured);
 }
 
 }  // namespace cellrt::detail

@@ -1,8 +1,9 @@
 // `--accel auto`: cellrt's fastest exact path for a mix of coherent and incoherent batches. It holds
 // two exact structures, SIMD packets over a study tree (fastest on coherent batches: a frame's primary
 // rays, shadow rays toward one light) and the wide BVH (fastest on incoherent ones: diffuse bounces,
-// AO, random queries), the latter traced one ray at a time or as a stream (unless streams=off)
-// (bvh_stream.inl: the batch's rays down the tree together), and routes each batch by its coherence
+// AO, random queries), the latter traced one ray at a time, as a stream (unless streams=off;
+// bvh_stream.inl: the batch's rays down the tree together) or in packets of eight rays (unless
+// bvh_packets=off; bvh_packet.inl), and routes each batch by its coherence
 // and by the time per ray each path has taken on batches of its kind (docs/BVH.md, docs/INCOHERENT.md).
 // Every path returns the brute-force hits, so the answers, and images, do not depend on the route.
 #pragma once
@@ -21,7 +22,8 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
 const ParamTable& routed_params();
 const std::vector<std::string>& routed_traversals();
 
-// Which of the router's paths (two, or three with the BVH's streams) traces the next batch of one
+// Which of the router's paths (two to four: the packets, the BVH's single rays, its streams and its
+// packets) traces the next batch of one
 // kind (closest or any hit, coherent or not): the one that has taken the least time per ray on the
 // batches of that kind that were timed. Every path is exact, so the choice changes the time, never an
 // answer, and every batch is traced once.
@@ -56,7 +58,7 @@ class RoutePicker {
 public:
     static constexpr std::uint64_t kPrior = 8, kRounds = 3, kPerPath = 3, kLearnRuns = 4, kSample = 16, kSampleFar = 64;
     static constexpr double kFar = 1.5;
-    static constexpr int kMaxPaths = 3;
+    static constexpr int kMaxPaths = 4;
 
     explicit RoutePicker(int paths = 2) : paths_(paths < 2 ? 2 : (paths > kMaxPaths ? kMaxPaths : paths)) {}
 
@@ -79,7 +81,7 @@ public:
     }
 
     struct Choice {
-        int path;    // 0: the packets, 1: the BVH's single rays, 2: the BVH's streams
+        int path;    // 0: the packets, 1: the BVH's single rays, then its streams and packets, where held
         bool timed;  // a counted batch (not the warm-up) of a timed run: time it and record() it
     };
 
@@ -140,8 +142,8 @@ private:
 
     int paths_;
     std::atomic<std::uint64_t> batches_{0};
-    std::atomic<std::uint64_t> samples_[kMaxPaths]{0, 0, 0};
-    std::atomic<double> seconds_[kMaxPaths]{0.0, 0.0, 0.0}, rays_[kMaxPaths]{0.0, 0.0, 0.0};
+    std::atomic<std::uint64_t> samples_[kMaxPaths]{};
+    std::atomic<double> seconds_[kMaxPaths]{}, rays_[kMaxPaths]{};
 };
 
 // The batch's coherence: the mean cosine between the directions of neighbouring rays, over up to 64
