@@ -72,6 +72,7 @@ struct LeafRay {
     F ox, oy, oz, sx, sy, sz;
     int kx, ky, kz;
 
+    LeafRay() = default;  // filled in later (bvh_packet.inl makes a packet's rays' on demand)
     explicit LeafRay(const WatertightRay& r)
         : ox(splat(r.org[r.kx])), oy(splat(r.org[r.ky])), oz(splat(r.org[r.kz])), sx(splat(r.sx)), sy(splat(r.sy)),
           sz(splat(r.sz)), kx(r.kx * kBvhWidth), ky(r.ky * kBvhWidth), kz(r.kz * kBvhWidth) {}

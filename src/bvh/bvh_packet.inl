@@ -52,15 +52,64 @@ struct PacketFrame {
     float entry;
 };
 
-// One packet through the tree. `rays` holds the lanes of valid rays; each lane's query, its
-// TraversalRay (for the single-ray kernel) and its LeafRay are at that index of the arrays. Returns
-// the rays of `rays` not answered: an any-hit query's misses.
+// The batch's rays [0, n) (n <= kPacketRays) in lanes: TraversalRay's set-up (the reciprocal
+// direction, its signs, the margin) in every ray's lane, in the same operations and order, so that
+// each lane holds its ray's very bits; its tfar in `tfar`. Returns the lanes of valid rays; the
+// others (invalid rays, lanes past n) hold a finite placeholder.
+inline unsigned load_packet(const Ray* rays, std::size_t n, const Box3& scene, PacketRays& p, F& tfar) {
+    static constexpr Ray kPlaceholder{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f};
+    float org[3][kPacketRays], dir[3][kPacketRays], near[kPacketRays], far[kPacketRays];
+    unsigned valid = 0;
+    for (std::size_t i = 0; i < kPacketRays; ++i) {
+        const bool ok = i < n && is_valid(rays[i]);
+        const Ray& r = ok ? rays[i] : kPlaceholder;
+        valid |= unsigned{ok} << i;
+        for (int a = 0; a < 3; ++a) {
+            org[a][i] = r.org[a];
+            dir[a][i] = r.dir[a];
+        }
+        near[i] = r.tnear;
+        far[i] = r.tfar;
+    }
+    const U no_sign = splat_u(0x7fffffffu);  // std::fabs clears the sign bit
+    F d[3], reach[3];
+    for (int a = 0; a < 3; ++a) {
+        const F o = load(org[a]);
+        d[a] = load(dir[a]);
+        p.org[a] = o;
+        p.inv[a] = splat(1.f) / d[a];
+        p.negative[a] = reinterpret_cast<I>(d[a]) < 0;  // the sign bit, -0 included (std::signbit)
+        const F lo = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.lo[a]) - o) & no_sign);
+        const F hi = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.hi[a]) - o) & no_sign);
+        reach[a] = select(lo < hi, hi, lo);  // std::max(lo, hi)
+    }
+    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
+    const F dir_length = sqrt_lanes(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    p.margin = splat(kMarginScale) * reach_length / dir_length;
+    p.tnear = load(near);
+    tfar = load(far);
+    return valid;
+}
+
+// One packet through the tree: the batch's rays [0, kPacketRays) in `p`, `rays` the lanes of valid
+// ones, each lane's query at its index of `q`. A ray's LeafRay is made when it first reaches a leaf
+// (a camera ray that misses the object never does). Returns the rays of `rays` not answered: an
+// any-hit query's misses.
 template <class Query, class Counters>
-unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const PacketRays& p, const TraversalRay* single,
-                  const LeafRay* leaf_rays, Query* q, unsigned rays, Counters& c) {
+unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const Ray* batch, const PacketRays& p, Query* q,
+                      unsigned rays, Counters& c) {
     constexpr bool kAny = Query::kAnyHit;
     F cull;
     for (int i = 0; i < kPacketRays; ++i) cull[i] = rays >> i & 1 ? q[i].cull_t() : -kInfinity;
+    LeafRay leaf_rays[kPacketRays];
+    unsigned leaf_made = 0;
+    const auto leaf_ray = [&](int i) -> const LeafRay& {
+        if (!(leaf_made >> i & 1)) {
+            leaf_rays[i] = LeafRay(WatertightRay(batch[i]));
+            leaf_made |= 1u << i;
+        }
+        return leaf_rays[i];
+    };
     unsigned active = rays;  // any hit: the rays not answered yet
     PacketFrame stack[kBvhStackSize + kBvhStackSlack];
     int size = 0;
@@ -73,7 +122,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const PacketR
                 const std::uint32_t count = BvhNode::leaf_count(word);
                 for (unsigned m = mask; m; m &= m - 1) {
                     const int i = __builtin_ctz(m);
-                    if (test_leaf(leaf, count, leaf_rays[i], q[i], c)) active &= ~(1u << i);
+                    if (test_leaf(leaf, count, leaf_ray(i), q[i], c)) active &= ~(1u << i);
                     if constexpr (!kAny) cull[i] = q[i].cull_t();
                 }
             } else {
@@ -113,8 +162,11 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const PacketR
             // Few rays left on this branch: each goes on with its own kernel from here.
             for (unsigned m = mask; m; m &= m - 1) {
                 const int i = __builtin_ctz(m);
-                if (traverse_bvh_from(nodes, leaves, BoxRay(single[i]), leaf_rays[i], word, q[i], c))
-                    active &= ~(1u << i);
+                const float org[3] = {p.org[0][i], p.org[1][i], p.org[2][i]};
+                const float inv[3] = {p.inv[0][i], p.inv[1][i], p.inv[2][i]};
+                const unsigned octant = (p.negative[0][i] & 1u) | (p.negative[1][i] & 1u) << 1 | (p.negative[2][i] & 1u) << 2;
+                const BoxRay box(org, inv, octant, p.tnear[i], p.margin[i]);
+                if (traverse_bvh_from(nodes, leaves, box, leaf_ray(i), word, q[i], c)) active &= ~(1u << i);
                 if constexpr (!kAny) cull[i] = q[i].cull_t();
             }
         }
@@ -133,9 +185,6 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const PacketR
     }
 }
 
-// A ray that stands in for an invalid one in its lane (whose answer is a miss): any finite ray.
-inline Ray packet_placeholder_ray() { return Ray{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f}; }
-
 // The batch in packets of kPacketRays consecutive rays (the last may be short); invalid rays
 // (ray.hpp) answer misses.
 template <class Query, class Answer>
@@ -144,40 +193,15 @@ void packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Answ
     with_counters(counters, rays.size(), [&](auto& count) {
         for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
             const std::size_t n = std::min<std::size_t>(kPacketRays, rays.size() - first);
-            unsigned valid = 0;
-            const auto ray = [&](std::size_t i) -> Ray {
-                if (i < n && is_valid(rays[first + i])) {
-                    valid |= 1u << i;
-                    return rays[first + i];
-                }
-                return packet_placeholder_ray();
-            };
+            PacketRays p;
+            F tfar;
+            const unsigned valid = load_packet(&rays[first], n, tree.bounds, p, tfar);
             const auto make = [&]<std::size_t... L>(std::index_sequence<L...>) {
-                return std::array<TraversalRay, kPacketRays>{TraversalRay(ray(L), tree.bounds)...};
+                return std::array<Query, kPacketRays>{Query(p.tnear[L], tfar[L], p.margin[L])...};
             };
-            const std::array<TraversalRay, kPacketRays> single = make(std::make_index_sequence<kPacketRays>());
-            const auto leaf = [&]<std::size_t... L>(std::index_sequence<L...>) {
-                return std::array<LeafRay, kPacketRays>{LeafRay(single[L].watertight)...};
-            };
-            const std::array<LeafRay, kPacketRays> leaf_rays = leaf(std::make_index_sequence<kPacketRays>());
-            const auto query = [&]<std::size_t... L>(std::index_sequence<L...>) {
-                return std::array<Query, kPacketRays>{Query(single[L])...};
-            };
-            std::array<Query, kPacketRays> q = query(std::make_index_sequence<kPacketRays>());
-            PacketRays p{};
-            for (int i = 0; i < kPacketRays; ++i) {
-                const TraversalRay& r = single[static_cast<std::size_t>(i)];
-                for (int a = 0; a < 3; ++a) {
-                    p.org[a][i] = r.org[a];
-                    p.inv[a][i] = r.inv_dir[a];
-                    p.negative[a][i] = r.dir_neg[a] ? -1 : 0;
-                }
-                p.tnear[i] = r.tnear;
-                p.margin[i] = r.margin;
-            }
+            std::array<Query, kPacketRays> q = make(std::make_index_sequence<kPacketRays>());
             const unsigned missed =
-                valid ? trace_packet(tree.nodes.data(), tree.leaves.data(), p, single.data(), leaf_rays.data(),
-                                     q.data(), valid, count)
+                valid ? trace_packet(tree.nodes.data(), tree.leaves.data(), &rays[first], p, q.data(), valid, count)
                       : 0u;
             for (std::size_t i = 0; i < n; ++i) {
                 if constexpr (Query::kAnyHit) out[first + i] = (valid & ~missed) >> i & 1;

@@ -90,7 +90,9 @@ struct ClosestHit {
     float tnear;
     float margin;
 
-    CELLRT_HD explicit ClosestHit(const TraversalRay& r) : best{r.tfar, kNoHit, 0.f, 0.f}, tnear(r.tnear), margin(r.margin) {}
+    CELLRT_HD explicit ClosestHit(const TraversalRay& r) : ClosestHit(r.tnear, r.tfar, r.margin) {}
+    // From the ray's interval and margin (TraversalRay's), as a SIMD set-up keeps them in lanes.
+    CELLRT_HD ClosestHit(float t_near, float t_far, float m) : best{t_far, kNoHit, 0.f, 0.f}, tnear(t_near), margin(m) {}
 
     CELLRT_HD float cull_t() const { return best.t + margin; }
     // Tests one triangle; `prim` gives its index in the scene (read only for a candidate). Returns
@@ -109,7 +111,8 @@ struct AnyHit {
     float tnear, tfar;
     float cull;
 
-    CELLRT_HD explicit AnyHit(const TraversalRay& r) : tnear(r.tnear), tfar(r.tfar), cull(r.tfar + r.margin) {}
+    CELLRT_HD explicit AnyHit(const TraversalRay& r) : AnyHit(r.tnear, r.tfar, r.margin) {}
+    CELLRT_HD AnyHit(float t_near, float t_far, float margin) : tnear(t_near), tfar(t_far), cull(t_far + margin) {}
 
     CELLRT_HD float cull_t() const { return cull; }
     template <class Prim>
