@@ -3,18 +3,19 @@
 // of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
 // against the packet's rays at once, giving the rays that meet it; the packet goes on to the children
 // some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
-// query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top). So a coherent packet reads each node, pops
-// the stack and takes each branch once for its eight rays, where single rays (bvh_kernels.inl) do it
-// once per ray; the arithmetic is the same. When one ray is left on a branch it goes on alone, with
-// the single-ray kernel, from the node it reached (kPacketSingleBelow).
+// query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top).
+// So a coherent packet reads each node, pops the stack and takes each branch once for its eight rays,
+// where single rays (bvh_kernels.inl) do it once per ray; the arithmetic is the same. When one ray is
+// left on a branch it goes on alone, with the single-ray kernel, from the node it reached
+// (kPacketSingleBelow).
 //
 // Exact: a ray's box test is meet_children's, lane for lane (the same operations in the same order,
 // the plane it enters and leaves by chosen by its own direction's signs), and its leaves are tested
 // by test_leaf with its own query. A ray therefore reaches a leaf only if it meets every box on the
 // way, and then tests it as its own kernel would; a waiting branch is dropped for a ray only when
-// the ray's best hit is nearer than the branch's entry minus the margin, when its own kernel would
-// drop it too. The hit rule picks the same answer whatever the order, so the answers are brute
-// force's.
+// the branch's smallest entry lies past the ray's cull distance (its best hit plus the margin), so
+// past the ray's own entry, where its own kernel drops the branch too. The hit rule picks the same
+// answer whatever the order, so the answers are brute force's.
 //
 // No include guard: included after bvh_kernels.inl in each instruction set's namespace.
 
@@ -180,7 +181,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const Ray* ba
             }
         }
         // The next waiting branch with a ray that still needs it: not answered (any hit), or whose
-        // best hit is not nearer than the branch's nearest entry minus the margin (closest hit).
+        // cull distance is not before the branch's smallest entry (closest hit).
         for (;;) {
             if (size == 0) return active;
             const PacketFrame& f = stack[--size];
