@@ -43,9 +43,8 @@ public:
     // paths[0] is the tree's packets and paths[1] the BVH's single rays (coherence names one of them);
     // the measured route may hold views of the BVH's tree traced otherwise (bvh_with_traversal) after them.
     RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
-        : paths_(std::move(paths)), count_(static_cast<int>(paths_.size())), threshold_(threshold),
-          packets_(std::move(packets)), measured_(measured),
-          pickers_{RoutePicker(count_), RoutePicker(count_), RoutePicker(count_), RoutePicker(count_)} {}
+        : paths_(std::move(paths)), threshold_(threshold), packets_(std::move(packets)), measured_(measured),
+          pickers_{RoutePicker(count()), RoutePicker(count()), RoutePicker(count()), RoutePicker(count())} {}
 
     AccelStats stats() const override {
         const AccelStats c = paths_[0].accel->stats(), i = paths_[1].accel->stats();
@@ -115,10 +114,10 @@ private:
         std::string out;
         for (int q = 0; q < 2; ++q) {
             double n[RoutePicker::kMaxPaths], sum = 0.0;
-            for (int p = 0; p < count_; ++p)
+            for (int p = 0; p < count(); ++p)
                 sum += n[p] = static_cast<double>(routed_[q][p].load(std::memory_order_relaxed));
             out += q ? "; any" : "closest";
-            for (int p = 0; p < count_; ++p) {
+            for (int p = 0; p < count(); ++p) {
                 char buf[48];
                 std::snprintf(buf, sizeof buf, " %s %.2f", paths_[p].name, sum > 0.0 ? n[p] / sum : 0.0);
                 out += buf;
@@ -129,7 +128,7 @@ private:
             const RoutePicker& picker = pickers_[k];
             if (picker.samples() == 0) continue;
             out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) + " batches), ns per ray";
-            for (int p = 0; p < count_; ++p) {
+            for (int p = 0; p < count(); ++p) {
                 char buf[48];
                 std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p));
                 out += buf;
@@ -141,8 +140,9 @@ private:
         return std::ranges::any_of(paths_, [&](const RoutePath& p) { return name == p.name; });
     }
 
+    int count() const { return static_cast<int>(paths_.size()); }
+
     std::vector<RoutePath> paths_;
-    int count_;  // paths_.size()
     float threshold_;
     std::string packets_;
     bool measured_;
