@@ -259,11 +259,12 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
 // timed, and a timed run interleaves it with the paths near it, and with the far ones less often.
 // `take(n, prior)` picks n batches and returns how many were timed, recording for each timed one
 // `per_ray[path]` seconds per ray (times `tile_cost(batch)`, the batch's own cost, when given) on a
-// batch of `rays` rays.
+// batch of `rays` rays, of which none hit (or `tile_hits(batch)` of them, when given).
 struct PickerRun {
     detail::RoutePicker& picker;
     std::vector<double> per_ray;
     std::function<double(std::uint64_t)> tile_cost = [](std::uint64_t) { return 1.0; };
+    std::function<double(std::uint64_t)> tile_hits = [](std::uint64_t) { return 0.0; };
     int paths_seen[detail::RoutePicker::kMaxPaths] = {};
     std::uint64_t batch = 0;
     int take(int n, int prior = 0, std::size_t rays = 100) {
@@ -274,7 +275,7 @@ struct PickerRun {
             if (!c.timed) continue;
             ++timed;
             picker.record(c.path, per_ray[static_cast<std::size_t>(c.path)] * tile_cost(batch) * static_cast<double>(rays),
-                          rays);
+                          rays, static_cast<std::size_t>(tile_hits(batch) * static_cast<double>(rays)));
         }
         return timed;
     }
@@ -303,7 +304,7 @@ TEST(Routed, PickerLearnsInInterleavedRunsThenTakesThePathOfLeastTimePerRay) {
                 EXPECT_EQ(c.timed, i % per != 0) << "run " << run << " round " << round << " batch " << i;
                 // Batches of different sizes: per ray the packets take 3 units, the BVH 2.
                 const std::size_t rays = 32 + 7 * i;
-                if (c.timed) picker.record(c.path, (c.path == 0 ? 3.0 : 2.0) * static_cast<double>(rays), rays);
+                if (c.timed) picker.record(c.path, (c.path == 0 ? 3.0 : 2.0) * static_cast<double>(rays), rays, rays / 2);
             }
         ++runs_led_by[first];
     }
@@ -352,8 +353,8 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     // choice from being clear.
     RoutePicker half(3);
     for (std::uint64_t i = 0; i < RoutePicker::kPrior + RoutePicker::kLearnRuns * half.run_length(); ++i) half.pick(1);
-    half.record(0, 3.0, 1);
-    half.record(1, 1.0, 1);
+    half.record(0, 3.0, 1, 0);
+    half.record(1, 1.0, 1, 1);
     EXPECT_EQ(half.cost(2), 0.0);
     EXPECT_EQ(half.fastest(0), 1);
     EXPECT_FALSE(half.far(2, 1));
@@ -366,13 +367,15 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
 // another saw mostly background.
 TEST(Routed, PickerComparesPathsOnTheSameStretchesOfTiles) {
     using detail::RoutePicker;
-    const auto tile_cost = [](std::uint64_t batch) {
+    const auto on_object = [](std::uint64_t batch) {
         const std::uint64_t tile = batch % 256, row = tile / 16, column = tile % 16;
-        return row >= 4 && row < 12 && column >= 5 && column < 11 ? 10.0 : 1.0;
+        return row >= 4 && row < 12 && column >= 5 && column < 11;
     };
+    const auto tile_cost = [&](std::uint64_t batch) { return on_object(batch) ? 10.0 : 1.0; };
+    const auto tile_hits = [&](std::uint64_t batch) { return on_object(batch) ? 1.0 : 0.0; };
     for (const int paths : {2, 3, 4}) {
         RoutePicker picker(paths);
-        PickerRun run{picker, {1.0, 1.3, 1.25, 1.15}, tile_cost};
+        PickerRun run{picker, {1.0, 1.3, 1.25, 1.15}, tile_cost, tile_hits};
         run.take(6 * 256, 1);  // six frames
         EXPECT_EQ(picker.fastest(1), 0) << paths << " paths: per ray packets " << picker.cost(0) << ", single rays "
                                         << picker.cost(1) << ", streams " << picker.cost(2);
@@ -381,6 +384,52 @@ TEST(Routed, PickerComparesPathsOnTheSameStretchesOfTiles) {
         run.take(later, 1);
         EXPECT_GT(run.paths_seen[0] - before, later * 9 / 10) << paths << " paths";
     }
+}
+
+// The bunny's camera tiles (docs/INCOHERENT.md, sixth round): a tile of background costs every path
+// 0.1 per ray; one on the object costs the kd-tree's packets (path 0) 1.5, the BVH's packets
+// (path 1) 1.0; a tile on the object's edge costs the kd packets as much as one on it (a packet
+// costs what its dearest ray does), the BVH's packets in proportion. Timed mostly on background,
+// the kd packets' plain time per ray undercuts the BVH packets', timed mostly on the object; per
+// class of hit fraction, weighted by every path's timed rays in each, the BVH's packets are the
+// cheaper, as over a whole frame.
+TEST(Routed, PickerComparesPathsOnTheSameMixOfHitFractions) {
+    detail::RoutePicker picker(2);
+    const std::size_t rays = 256;
+    const auto tile = [&](int path, std::size_t hits) {
+        const double h = static_cast<double>(hits) / rays, object = hits == 0 ? 0.0 : path == 0 ? 1.0 : h;
+        picker.record(path, static_cast<double>(rays) * (0.1 + object * (path == 0 ? 1.4 : 0.9)), rays, hits);
+    };
+    for (int i = 0; i < 16; ++i) tile(0, 0), tile(1, rays);
+    for (int i = 0; i < 4; ++i) tile(0, 64), tile(1, 64);
+    for (int i = 0; i < 4; ++i) tile(0, rays), tile(1, 0);
+    const double plain0 = picker.seconds(0) / picker.rays(0), plain1 = picker.seconds(1) / picker.rays(1);
+    EXPECT_LT(plain0, plain1);
+    const auto m = picker.mix();  // rays hitting none, some, all
+    EXPECT_DOUBLE_EQ(m[0], 20.0 / 48);
+    EXPECT_DOUBLE_EQ(m[1], 8.0 / 48);
+    EXPECT_DOUBLE_EQ(m[2], 20.0 / 48);
+    EXPECT_NEAR(picker.cost(0), m[0] * 0.1 + (m[1] + m[2]) * 1.5, 1e-12);
+    EXPECT_NEAR(picker.cost(1), m[0] * 0.1 + m[1] * (0.1 + 0.9 / 4) + m[2] * 1.0, 1e-12);
+    EXPECT_EQ(picker.fastest(0), 1);
+
+    // A class that some path was not timed in (here the kd packets' tiles of all hits, the BVH
+    // packets' of some) is left out for every path.
+    detail::RoutePicker gap(2);
+    gap.record(0, 10.0, 100, 0), gap.record(0, 50.0, 100, 30), gap.record(1, 5.0, 100, 0), gap.record(1, 7.0, 100, 100);
+    EXPECT_DOUBLE_EQ(gap.mix()[0], 1.0);
+    EXPECT_DOUBLE_EQ(gap.cost(0), 0.1);
+    EXPECT_DOUBLE_EQ(gap.cost(1), 0.05);
+    // No class shared: the plain time per ray.
+    detail::RoutePicker apart(2);
+    apart.record(0, 10.0, 100, 0), apart.record(0, 50.0, 100, 30), apart.record(1, 7.0, 100, 100);
+    EXPECT_DOUBLE_EQ(apart.cost(0), 60.0 / 200);
+    EXPECT_DOUBLE_EQ(apart.cost(1), 7.0 / 100);
+    // Batches all of one class (a frame inside a building: every ray hits): the plain time per ray.
+    detail::RoutePicker alike(2);
+    for (int i = 0; i < 10; ++i) alike.record(0, 2.0 + i, 100, 100), alike.record(1, 1.0 + i, 100, 100);
+    EXPECT_DOUBLE_EQ(alike.cost(0), alike.seconds(0) / alike.rays(0));
+    EXPECT_DOUBLE_EQ(alike.cost(1), alike.seconds(1) / alike.rays(1));
 }
 
 // Once the picker knows: one run in kSample is timed; it interleaves the fastest with every path

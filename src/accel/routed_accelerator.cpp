@@ -71,18 +71,24 @@ private:
     static constexpr std::size_t kMeasuredBatch = 32;
 
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
-        route(rays, 0, [&](const Accelerator& a, TraversalCounters* c) { a.intersect(rays, hits, c); }, counters);
+        route(
+            rays, 0, [&](const Accelerator& a, TraversalCounters* c) { a.intersect(rays, hits, c); },
+            [&] { return static_cast<std::size_t>(std::ranges::count_if(hits, [](const Hit& h) { return h.is_hit(); })); },
+            counters);
     }
     void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                      TraversalCounters* counters) const override {
-        route(rays, 1, [&](const Accelerator& a, TraversalCounters* c) { a.occluded(rays, occluded, c); }, counters);
+        route(
+            rays, 1, [&](const Accelerator& a, TraversalCounters* c) { a.occluded(rays, occluded, c); },
+            [&] { return static_cast<std::size_t>(std::ranges::count_if(occluded, [](std::uint8_t o) { return o != 0; })); },
+            counters);
     }
 
     // Traces the batch on the path coherence names (the packets or the BVH's single rays) or, when
     // measured, on the one its kind's picker names, timing it when the picker asks (RoutePicker).
-    // `query` is 0 for closest hits, 1 for any.
-    template <class Trace>
-    void route(std::span<const Ray> rays, int query, Trace&& trace, TraversalCounters* counters) const {
+    // `query` is 0 for closest hits, 1 for any; `hits` counts the traced batch's hits (or occluded rays).
+    template <class Trace, class CountHits>
+    void route(std::span<const Ray> rays, int query, Trace&& trace, CountHits&& hits, TraversalCounters* counters) const {
         const int prior = batch_coherence(rays) >= threshold_ ? 0 : 1;
         if (!measured_ || rays.size() < kMeasuredBatch) {
             count_rays(query, prior, rays.size());
@@ -101,7 +107,8 @@ private:
         if (!choice.timed) return trace(*paths_[choice.path].accel, counters);
         const double start = thread_seconds();
         trace(*paths_[choice.path].accel, counters);
-        if (warm) picker.record(choice.path, thread_seconds() - start, rays.size());
+        const double seconds = thread_seconds() - start;
+        if (warm) picker.record(choice.path, seconds, rays.size(), hits());
     }
 
     void count_rays(int query, int path, std::size_t n) const {
@@ -127,7 +134,11 @@ private:
         for (int k = 0; k < 4; ++k) {
             const RoutePicker& picker = pickers_[k];
             if (picker.samples() == 0) continue;
-            out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) + " batches), ns per ray";
+            const auto m = picker.mix();
+            char mix[64];
+            std::snprintf(mix, sizeof mix, "%.2f/%.2f/%.2f", m[0], m[1], m[2]);
+            out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) +
+                   " batches, rays hitting none/some/all " + mix + "), ns per ray";
             for (int p = 0; p < count(); ++p) {
                 char buf[48];
                 std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p));

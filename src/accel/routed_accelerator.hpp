@@ -8,6 +8,7 @@
 // Every path returns the brute-force hits, so the answers, and images, do not depend on the route.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -45,6 +46,21 @@ const std::vector<std::string>& routed_traversals();
 // Several threads share a picker, so a run's batches go to whichever thread asks next; the router
 // counts a timed batch only when the same thread's previous batch of the kind took the same path.
 //
+// Which batches a path is timed on still moves its mean: the bunny's camera tiles on the object
+// cost ten times those of background, and with 24 counted tiles per path while learning, the
+// kd-tree's packets were timed at 106 ns per ray where the whole frame takes them 152, the BVH's
+// packets at 128 where it takes them 92 (docs/INCOHERENT.md, sixth round). What sets a tile's cost
+// is mostly how many of its rays hit something (a ray that misses leaves in a few nodes), and that
+// is known after the batch, the same for every path. So the times are post-stratified: counted
+// batches fall in kStrata classes by their hit fraction (none of its rays hit, some, all: closest
+// hits, or occluded rays), a path's time per ray is taken per class, and its cost is their mean
+// weighted by the rays of every path's counted batches in each class, so that every path is
+// compared on the same mix. Classes rather than a line through the hit fraction: a packet of rays
+// costs nearly as much when a few of its rays reach the object as when all do, and a straight line
+// fitted to that read the teapot's camera tiles the wrong way round. A class that some path was
+// not timed in is left out for all; where all batches are of one class (Sponza's camera tiles:
+// every ray hits) the cost is the plain time per ray.
+//
 // The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
 // Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path; then
 // the fastest path takes every run but one in kSample, chosen by a hash of the run's number (not
@@ -59,6 +75,8 @@ public:
     static constexpr std::uint64_t kPrior = 8, kRounds = 3, kPerPath = 3, kLearnRuns = 4, kSample = 16, kSampleFar = 64;
     static constexpr double kFar = 1.5;
     static constexpr int kMaxPaths = 4;
+    // Classes of a batch's hit fraction: none, some, all.
+    static constexpr int kStrata = 3;
 
     explicit RoutePicker(int paths = 2) : paths_(paths < 2 ? 2 : (paths > kMaxPaths ? kMaxPaths : paths)) {}
 
@@ -67,17 +85,46 @@ public:
     std::uint64_t run_length() const { return kPerPath * kRounds * static_cast<std::uint64_t>(paths_); }
     // The batches counted for `path`, their time in seconds and their rays.
     std::uint64_t samples(int path) const { return samples_[path].load(std::memory_order_relaxed); }
-    double seconds(int path) const { return seconds_[path].load(std::memory_order_relaxed); }
-    double rays(int path) const { return rays_[path].load(std::memory_order_relaxed); }
+    double seconds(int path) const { return sum(seconds_[path]); }
+    double rays(int path) const { return sum(rays_[path]); }
     std::uint64_t samples() const {
         std::uint64_t n = 0;
         for (int p = 0; p < paths_; ++p) n += samples(p);
         return n;
     }
-    // A path's time per ray over its counted batches; 0 when it has none.
+    // A path's time per ray at the kind's mix of hit fractions (above); 0 when it has no counted batch.
     double cost(int path) const {
         const double n = rays(path);
-        return n > 0.0 ? seconds(path) / n : 0.0;
+        if (!(n > 0.0)) return 0.0;
+        const std::array<double, kStrata> m = mix();
+        double mixed = 0.0, weights = 0.0;
+        for (int c = 0; c < kStrata; ++c) {
+            const auto weight = m[static_cast<std::size_t>(c)];
+            if (weight == 0.0) continue;
+            mixed += weight * load(seconds_[path][c]) / load(rays_[path][c]);
+            weights += weight;
+        }
+        return weights > 0.0 ? mixed / weights : seconds(path) / n;
+    }
+    // The shares of the counted rays in the classes of hit fraction in which every path with counted
+    // batches has some: a class that one path lacks is left out for all, so that all are read on
+    // the same mix (none left: all zero, and each path's cost is its plain time per ray).
+    std::array<double, kStrata> mix() const {
+        std::array<double, kStrata> m{};
+        double total = 0.0;
+        for (int c = 0; c < kStrata; ++c) {
+            bool shared = true;
+            for (int p = 0; p < paths_; ++p)
+                if (rays(p) > 0.0) {
+                    m[static_cast<std::size_t>(c)] += load(rays_[p][c]);
+                    shared = shared && load(rays_[p][c]) > 0.0;
+                }
+            if (!shared) m[static_cast<std::size_t>(c)] = 0.0;
+            total += m[static_cast<std::size_t>(c)];
+        }
+        if (total > 0.0)
+            for (double& x : m) x /= total;
+        return m;
     }
 
     struct Choice {
@@ -119,10 +166,13 @@ public:
     }
     // Whether `path` costs more than kFar times `fast` (a path with nothing counted does not).
     bool far(int path, int fast) const { return cost(fast) > 0.0 && cost(path) > kFar * cost(fast); }
-    // A counted batch of a timed run: its path, its thread's CPU time and its rays.
-    void record(int path, double seconds, std::size_t rays) {
-        add(seconds_[path], seconds);
-        add(rays_[path], static_cast<double>(rays));
+    // A counted batch of a timed run: its path, its thread's CPU time, its rays and how many of them
+    // hit (closest hit) or were occluded (any hit).
+    void record(int path, double seconds, std::size_t rays, std::size_t hits) {
+        if (rays == 0) return;
+        const int c = hits == 0 ? 0 : hits == rays ? 2 : 1;
+        add(seconds_[path][c], seconds);
+        add(rays_[path][c], static_cast<double>(rays));
         samples_[path].fetch_add(1, std::memory_order_relaxed);
     }
 
@@ -134,6 +184,12 @@ private:
         x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
         return x ^ (x >> 31);
     }
+    static double load(const std::atomic<double>& x) { return x.load(std::memory_order_relaxed); }
+    static double sum(const std::atomic<double> (&x)[kStrata]) {
+        double s = 0.0;
+        for (const auto& v : x) s += load(v);
+        return s;
+    }
     static void add(std::atomic<double>& sum, double x) {
         for (double old = sum.load(std::memory_order_relaxed);
              !sum.compare_exchange_weak(old, old + x, std::memory_order_relaxed);) {
@@ -143,7 +199,8 @@ private:
     int paths_;
     std::atomic<std::uint64_t> batches_{0};
     std::atomic<std::uint64_t> samples_[kMaxPaths]{};
-    std::atomic<double> seconds_[kMaxPaths]{}, rays_[kMaxPaths]{};
+    // Per path and class of hit fraction: the counted batches' seconds and rays.
+    std::atomic<double> seconds_[kMaxPaths][kStrata]{}, rays_[kMaxPaths][kStrata]{};
 };
 
 // The batch's coherence: the mean cosine between the directions of neighbouring rays, over up to 64
