@@ -93,10 +93,11 @@ public:
         return n;
     }
     // A path's time per ray at the kind's mix of hit fractions (above); 0 when it has no counted batch.
-    double cost(int path) const {
+    double cost(int path) const { return cost(path, mix()); }
+    // The same at a mix computed once for several paths.
+    double cost(int path, const std::array<double, kStrata>& m) const {
         const double n = rays(path);
         if (!(n > 0.0)) return 0.0;
-        const std::array<double, kStrata> m = mix();
         double mixed = 0.0, weights = 0.0;
         for (int c = 0; c < kStrata; ++c) {
             const auto weight = m[static_cast<std::size_t>(c)];
@@ -159,9 +160,13 @@ public:
     }
     // The path of least time per ray among those with counted batches; the prior while none has.
     int fastest(int prior) const {
+        const std::array<double, kStrata> m = mix();
         int fast = -1;
-        for (int p = 0; p < paths_; ++p)
-            if (cost(p) > 0.0 && (fast < 0 || cost(p) < cost(fast))) fast = p;
+        double least = 0.0;
+        for (int p = 0; p < paths_; ++p) {
+            const double c = cost(p, m);
+            if (c > 0.0 && (fast < 0 || c < least)) fast = p, least = c;
+        }
         return fast < 0 ? prior : fast;
     }
     // Whether `path` costs more than kFar times `fast` (a path with nothing counted does not).
