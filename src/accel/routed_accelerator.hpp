@@ -98,30 +98,34 @@ public:
     double cost(int path, const std::array<double, kStrata>& m) const {
         const double n = rays(path);
         if (!(n > 0.0)) return 0.0;
-        double mixed = 0.0, weights = 0.0;
+        double mixed = 0.0;
+        bool any = false;
         for (int c = 0; c < kStrata; ++c) {
             const auto weight = m[static_cast<std::size_t>(c)];
             if (weight == 0.0) continue;
             mixed += weight * load(seconds_[path][c]) / load(rays_[path][c]);
-            weights += weight;
+            any = true;
         }
-        return weights > 0.0 ? mixed / weights : seconds(path) / n;
+        return any ? mixed : seconds(path) / n;
     }
     // The shares of the counted rays in the classes of hit fraction in which every path with counted
     // batches has some: a class that one path lacks is left out for all, so that all are read on
     // the same mix (none left: all zero, and each path's cost is its plain time per ray).
     std::array<double, kStrata> mix() const {
         std::array<double, kStrata> m{};
+        std::array<bool, kStrata> missing{};  // by some path with counted batches
+        for (int p = 0; p < paths_; ++p) {
+            if (!(rays(p) > 0.0)) continue;
+            for (std::size_t c = 0; c < kStrata; ++c) {
+                const double n = load(rays_[p][c]);
+                m[c] += n;
+                missing[c] = missing[c] || !(n > 0.0);
+            }
+        }
         double total = 0.0;
-        for (int c = 0; c < kStrata; ++c) {
-            bool shared = true;
-            for (int p = 0; p < paths_; ++p)
-                if (rays(p) > 0.0) {
-                    m[static_cast<std::size_t>(c)] += load(rays_[p][c]);
-                    shared = shared && load(rays_[p][c]) > 0.0;
-                }
-            if (!shared) m[static_cast<std::size_t>(c)] = 0.0;
-            total += m[static_cast<std::size_t>(c)];
+        for (std::size_t c = 0; c < kStrata; ++c) {
+            if (missing[c]) m[c] = 0.0;
+            total += m[c];
         }
         if (total > 0.0)
             for (double& x : m) x /= total;
