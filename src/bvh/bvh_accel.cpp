@@ -46,13 +46,14 @@ public:
         r.max_depth = tree().depth;
         r.mean_leaf_depth = tree().mean_leaf_depth;
         r.triangles_per_leaf = tree().mean_leaf_triangles;
-        r.references_per_triangle = triangle_count_ ? 1.0 : 0.0;
+        r.references_per_triangle = triangle_count_ ? double(tree().references) / double(triangle_count_) : 0.0;
         r.sah_cost = tree().sah_cost;
         s.tree = r;
         s.settings = {{"bins", std::to_string(options_.bins)},
                       {"max_leaf", std::to_string(options_.max_leaf)},
                       {"traversal_cost", param_number(options_.traversal_cost)},
                       {"intersection_cost", param_number(options_.intersection_cost)},
+                      {"split_budget", param_number(options_.split_budget)},
                       {"isa", kernels_.isa}};
         return s;
     }
@@ -97,6 +98,8 @@ const ParamTable& bvh_params() {
         {"traversal_cost", number, "1", 0.001, 1000, {}, "SAH cost of visiting a node (eight box tests)"},
         {"intersection_cost", number, "2", 0.001, 1000, {},
          "SAH cost of testing a leaf (up to eight triangles at once)"},
+        {"split_budget", number, "0.5", 0, 4, {},
+         "spatial splits (Stich et al. 2009): at most this many extra references per triangle; 0 builds without them"},
     };
     return table;
 }
@@ -116,6 +119,7 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.max_leaf = params.integer("max_leaf");
     options.traversal_cost = params.number("traversal_cost");
     options.intersection_cost = params.number("intersection_cost");
+    options.split_budget = params.number("split_budget");
     params.finish();
     return std::make_unique<BvhAccelerator>(triangles, options, kernels, traversal_named(config.traversal));
 }

@@ -20,6 +20,7 @@ struct BvhBuildOptions {
     int max_leaf = 8;                // triangles per leaf, 1..8 (a leaf is one 8-lane group)
     double traversal_cost = 1.0;     // of visiting a node (eight box tests)
     double intersection_cost = 2.0;  // of testing a leaf (up to eight triangles at once)
+    double split_budget = 0.5;       // spatial splits: at most this many extra references per triangle
 };
 
 struct BvhTree {
@@ -29,6 +30,7 @@ struct BvhTree {
     int depth = 0;               // of the deepest wide node, the root's being 0
     std::size_t binary_nodes = 0;
     double sah_cost = 0.0;       // of the binary tree, in the options' cost units
+    std::size_t references = 0;  // triangles in leaves, a triangle cut by spatial splits once per leaf
     double mean_leaf_triangles = 0.0;
     double mean_leaf_depth = 0.0;  // a leaf's depth is its wide parent's plus one
 };

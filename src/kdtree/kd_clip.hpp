@@ -8,31 +8,9 @@
 
 #include "cellrt/box.hpp"
 #include "cellrt/triangle.hpp"
+#include "kernel/outward.hpp"
 
 namespace cellrt::detail::kdbuild {
-
-// std::nextafter(f, -inf) and std::nextafter(f, +inf), without the library call (which takes a
-// third of the clipping time).
-inline float float_step_down(float f) {
-    if (f == 0.f) return -std::numeric_limits<float>::denorm_min();
-    if (std::isnan(f) || f == -std::numeric_limits<float>::infinity()) return f;
-    const auto bits = std::bit_cast<std::uint32_t>(f);
-    return std::bit_cast<float>(f > 0.f ? bits - 1 : bits + 1);
-}
-inline float float_step_up(float f) { return -float_step_down(-f); }
-
-// Rounds a double down / up to the next float, then one more float step outward: the clipped
-// polygon is computed in double, and this keeps its float box conservative.
-inline float float_below(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = float_step_down(f);
-    return float_step_down(f);
-}
-inline float float_above(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) < x) f = float_step_up(f);
-    return float_step_up(f);
-}
 
 // A triangle clipped to axis-aligned half-spaces one at a time (Sutherland-Hodgman, in double
 // precision). Cutting a convex polygon by a plane adds at most one vertex: 3 + 6 planes. Each cut
