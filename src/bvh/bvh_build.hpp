@@ -1,8 +1,11 @@
 // The wide BVH's builder: a binary BVH by the surface area heuristic over binned centroids (Wald,
-// "On fast Construction of SAH-based Bounding Volume Hierarchies", RT 2007), collapsed into nodes of
-// eight children by pulling up the largest child until a node is full (Wald, Benthin, Boulos 2008,
-// section 3). Each triangle lies in exactly one leaf, and every box is the exact bounds of what lies
-// below it, so a conservative box test (kernel/traversal.hpp's margin) never misses a hit.
+// "On fast Construction of SAH-based Bounding Volume Hierarchies", RT 2007), with spatial splits
+// where large triangles overlap (Stich, Friedrich, Dietrich, "Spatial Splits in Bounding Volume
+// Hierarchies", HPG 2009), collapsed into nodes of eight children by pulling up the largest child
+// until a node is full (Wald, Benthin, Boulos 2008, section 3). Without spatial splits each triangle
+// lies in exactly one leaf and every box is the exact bounds of what lies below it; with them a
+// triangle cut by a plane lies in a leaf on each side, each box holding its part, so a conservative
+// box test (kernel/traversal.hpp's margin) never misses a hit either way.
 #pragma once
 
 #include <cstddef>
