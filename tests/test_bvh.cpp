@@ -227,6 +227,36 @@ TEST(Bvh, SameInputSameTree) {
     EXPECT_EQ(std::memcmp(a.leaves.data(), b.leaves.data(), a.leaves.size() * sizeof(detail::BvhLeaf)), 0);
 }
 
+// The build's tasks change nothing: the same nodes, leaves and SAH cost at every thread count, also
+// with tasks from small nodes on, with and without spatial splits.
+TEST(Bvh, SameTreeAtAnyThreadCount) {
+    const std::vector<Triangle> strips = tilted_strips();
+    const Scene& city = test::cached_scene("builtin:city?tris=20000");
+    for (const auto& [name, tris] : {std::pair{"tilted strips", std::span<const Triangle>(strips)},
+                                     std::pair{"city", std::span<const Triangle>(city.triangles)}})
+        for (const double budget : {0.0, 0.5}) {
+            BvhBuildOptions one;
+            one.threads = 1;
+            one.split_budget = budget;
+            const BvhTree a = detail::build_bvh(tris, one);
+            for (const unsigned threads : {2u, 3u, 0u})
+                for (const std::size_t parallel_min : {std::size_t{64}, std::size_t{4096}}) {
+                    BvhBuildOptions o = one;
+                    o.threads = threads;
+                    o.parallel_min = parallel_min;
+                    const BvhTree b = detail::build_bvh(tris, o);
+                    SCOPED_TRACE(std::string(name) + ", budget " + std::to_string(budget) + ", " +
+                                 std::to_string(threads) + " threads, tasks from " + std::to_string(parallel_min));
+                    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+                    ASSERT_EQ(a.leaves.size(), b.leaves.size());
+                    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)), 0);
+                    EXPECT_EQ(std::memcmp(a.leaves.data(), b.leaves.data(), a.leaves.size() * sizeof(detail::BvhLeaf)), 0);
+                    EXPECT_EQ(a.sah_cost, b.sah_cost);
+                    EXPECT_EQ(a.references, b.references);
+                }
+        }
+}
+
 // Rays that run exactly along the faces of the tree's own boxes (where the slab test's distances are
 // 0 x infinity) and start on them.
 TEST(Bvh, RaysAlongItsOwnBoxFaces) {

@@ -120,6 +120,7 @@ std::unique_ptr<Accelerator> make_bvh(std::span<const Triangle> triangles, const
     options.traversal_cost = params.number("traversal_cost");
     options.intersection_cost = params.number("intersection_cost");
     options.split_budget = params.number("split_budget");
+    options.threads = config.threads;
     params.finish();
     return std::make_unique<BvhAccelerator>(triangles, options, kernels, traversal_named(config.traversal));
 }

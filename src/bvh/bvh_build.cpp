@@ -5,8 +5,12 @@
 #include <cmath>
 #include <utility>
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
 #include "cellrt/ray.hpp"
 #include "kernel/outward.hpp"
+#include "kernel/subtree.hpp"
 
 namespace cellrt::detail {
 namespace {
@@ -77,8 +81,8 @@ std::pair<Box3, Box3> split_reference(const Triangle& tri, const Box3& box, int 
 class BinaryBuilder {
 public:
     BinaryBuilder(std::span<const Triangle> triangles, const BvhBuildOptions& o) : tris_(triangles), o_(o) {
-        nodes_.reserve(2 * tris_.size());
-        order_.reserve(tris_.size());
+        tree_.nodes.reserve(2 * tris_.size());
+        tree_.order.reserve(tris_.size());
     }
 
     void build() {
@@ -89,11 +93,21 @@ public:
             root.extend(refs[i].box);
         }
         root_area_ = area(root);
-        build(std::move(refs), 0, o_.split_budget * static_cast<double>(tris_.size()));
+        auto run = [&] { build(tree_, std::move(refs), 0, o_.split_budget * static_cast<double>(tris_.size())); };
+        if (o_.threads == 1) {
+            run();
+        } else {
+            tbb::task_arena arena(build_concurrency(o_.threads));
+            arena.execute(run);
+        }
+        // Summed in the nodes' order, which is the depth-first order of the sequential recursion:
+        // the same bits at any thread count.
+        for (const BinaryNode& n : tree_.nodes)
+            cost_ += (n.leaf ? leaf_cost(n.count) : o_.traversal_cost) * area(n.box);
     }
 
-    const std::vector<BinaryNode>& nodes() const { return nodes_; }
-    const std::vector<std::uint32_t>& order() const { return order_; }
+    const std::vector<BinaryNode>& nodes() const { return tree_.nodes; }
+    const std::vector<std::uint32_t>& order() const { return tree_.order; }
     double cost() const { return cost_; }
 
 private:
@@ -169,7 +183,8 @@ private:
     // bin it crosses, its box is cut to the planes instead: the union of the cut boxes left of a
     // plane is the union of the boxes entering before it, cut at the plane, so one box per bin
     // and side is enough (on Sponza the SAH cost of the tree is within 0.1% of clipping's, for a
-    // fifth of the search's work). The children's boxes come from the clipped parts (split_reference).
+    // quarter of the search's instructions). The children's boxes come from the clipped parts
+    // (split_reference).
     // The cheapest plane between bins whose extra references fit in `budget`; axis -1 when none does.
     Split spatial_split(std::span<const Ref> refs, double parent, const Box3& box, double budget) const {
         Split best;
@@ -233,17 +248,44 @@ private:
         }
     }
 
-    // Builds the subtree of `refs` (consumed), which may add at most `budget` references by
-    // spatial splits; a split hands what is left of it to its children by their sizes.
-    std::uint32_t build(std::vector<Ref>&& refs, int depth, double budget) {
+    // A binary tree or a piece of one: its nodes depth-first (a node's left child right after it),
+    // and the leaves' triangles, leaf by leaf.
+    struct Piece {
+        std::vector<BinaryNode> nodes;
+        std::vector<std::uint32_t> order;
+    };
+
+    // Appends `p`, built on its own with indices from 0, to `out`, as if built there; returns
+    // the index of its root.
+    static std::uint32_t append(Piece& out, const Piece& p) {
+        const auto base = static_cast<std::uint32_t>(out.nodes.size());
+        const auto first = static_cast<std::uint32_t>(out.order.size());
+        for (BinaryNode n : p.nodes) {
+            if (n.leaf) {
+                n.first += first;
+            } else {
+                n.left += base;
+                n.right += base;
+            }
+            out.nodes.push_back(n);
+        }
+        out.order.insert(out.order.end(), p.order.begin(), p.order.end());
+        return base;
+    }
+
+    // Builds the subtree of `refs` (consumed) into `out`, which may add at most `budget` references
+    // by spatial splits; a split hands what is left of it to its children by their sizes. In a
+    // parallel build the children of a large node are built as two tasks, each into a piece of its
+    // own, appended in order: the nodes and their indices are the sequential build's.
+    std::uint32_t build(Piece& out, std::vector<Ref>&& refs, int depth, double budget) {
         Box3 box, cbox;
         for (const Ref& r : refs) {
             box.extend(r.box);
             cbox.extend(r.box.center());
         }
-        const auto index = static_cast<std::uint32_t>(nodes_.size());
-        nodes_.push_back({});
-        nodes_[index].box = box;
+        const auto index = static_cast<std::uint32_t>(out.nodes.size());
+        out.nodes.push_back({});
+        out.nodes[index].box = box;
         const double a = area(box);
         const std::size_t count = refs.size();
         Split object, split;
@@ -257,11 +299,10 @@ private:
         }
         const bool fits = count <= static_cast<std::size_t>(o_.max_leaf);
         if (count <= 1 || (fits && (split.axis < 0 || leaf_cost(count) <= split.cost))) {
-            nodes_[index].leaf = true;
-            nodes_[index].first = static_cast<std::uint32_t>(order_.size());
-            nodes_[index].count = static_cast<std::uint32_t>(count);
-            for (const Ref& r : refs) order_.push_back(r.prim);
-            cost_ += leaf_cost(count) * a;
+            out.nodes[index].leaf = true;
+            out.nodes[index].first = static_cast<std::uint32_t>(out.order.size());
+            out.nodes[index].count = static_cast<std::uint32_t>(count);
+            for (const Ref& r : refs) out.order.push_back(r.prim);
             return index;
         }
         std::vector<Ref> left, right;
@@ -288,18 +329,27 @@ private:
         std::vector<Ref>().swap(refs);
         const double left_over = std::max(0.0, budget - static_cast<double>(left.size() + right.size() - count));
         const double share = static_cast<double>(left.size()) / static_cast<double>(left.size() + right.size());
-        cost_ += o_.traversal_cost * a;
-        const std::uint32_t l = build(std::move(left), depth + 1, left_over * share);
-        const std::uint32_t r = build(std::move(right), depth + 1, left_over * (1.0 - share));
-        nodes_[index].left = l;
-        nodes_[index].right = r;
+        std::uint32_t l = 0, r = 0;
+        if (o_.threads != 1 && count >= o_.parallel_min) {
+            Piece lp, rp;
+            tbb::task_group group;
+            group.run([&] { build(lp, std::move(left), depth + 1, left_over * share); });
+            build(rp, std::move(right), depth + 1, left_over * (1.0 - share));
+            group.wait();
+            l = append(out, lp);
+            r = append(out, rp);
+        } else {
+            l = build(out, std::move(left), depth + 1, left_over * share);
+            r = build(out, std::move(right), depth + 1, left_over * (1.0 - share));
+        }
+        out.nodes[index].left = l;
+        out.nodes[index].right = r;
         return index;
     }
 
     std::span<const Triangle> tris_;
     BvhBuildOptions o_;
-    std::vector<std::uint32_t> order_;  // the leaves' triangles, leaf by leaf
-    std::vector<BinaryNode> nodes_;
+    Piece tree_;
     double root_area_ = 0.0;
     double cost_ = 0.0;  // sum of cost x area
 };
