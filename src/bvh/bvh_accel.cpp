@@ -99,7 +99,7 @@ const ParamTable& bvh_params() {
         {"intersection_cost", number, "2", 0.001, 1000, {},
          "SAH cost of testing a leaf (up to eight triangles at once)"},
         {"split_budget", number, "0.5", 0, 4, {},
-         "spatial splits (Stich et al. 2009): at most this many extra references per triangle; 0 builds without them"},
+         "spatial splits (Stich et al. 2009): about this many extra references per triangle; 0 builds without them"},
     };
     return table;
 }

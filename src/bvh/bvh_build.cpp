@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
+#include "cellrt/error.hpp"
 #include "cellrt/ray.hpp"
 #include "kernel/outward.hpp"
 #include "kernel/subtree.hpp"
@@ -18,6 +19,8 @@ namespace {
 // Beyond this depth the binary build splits at the object median, so that a pathological scene (one
 // triangle cut off per level) cannot recurse once per triangle.
 constexpr int kSahDepth = 64;
+// A child word holds a leaf's index in 28 bits (bvh_node.hpp).
+constexpr std::size_t kMaxLeaves = std::size_t{1} << 28;
 
 double area(const Box3& b) { return b.is_empty() ? 0.0 : static_cast<double>(b.area()); }
 
@@ -327,7 +330,8 @@ private:
             right.assign(mid, refs.end());
         }
         std::vector<Ref>().swap(refs);
-        const double left_over = std::max(0.0, budget - static_cast<double>(left.size() + right.size() - count));
+        const double added = static_cast<double>(left.size() + right.size()) - static_cast<double>(count);
+        const double left_over = std::max(0.0, budget - added);
         const double share = static_cast<double>(left.size()) / static_cast<double>(left.size() + right.size());
         std::uint32_t l = 0, r = 0;
         if (o_.threads != 1 && count >= o_.parallel_min) {
@@ -421,6 +425,8 @@ private:
             }
             l.prim[lane] = prim;
         }
+        if (out_.leaves.size() >= kMaxLeaves)
+            throw Error("bvh: more leaves than a child word can address (2^28); raise max_leaf or lower split_budget");
         out_.leaves.push_back(l);
         return BvhNode::leaf_word(static_cast<std::uint32_t>(out_.leaves.size() - 1), c.count);
     }

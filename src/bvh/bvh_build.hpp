@@ -23,7 +23,7 @@ struct BvhBuildOptions {
     int max_leaf = 8;                // triangles per leaf, 1..8 (a leaf is one 8-lane group)
     double traversal_cost = 1.0;     // of visiting a node (eight box tests)
     double intersection_cost = 2.0;  // of testing a leaf (up to eight triangles at once)
-    double split_budget = 0.5;       // spatial splits: at most this many extra references per triangle
+    double split_budget = 0.5;       // spatial splits: about this many extra references per triangle
     unsigned threads = 0;            // build threads; 0: all hardware threads. The tree is the same for every value.
     // In parallel builds, the children of nodes with at least this many references are built as
     // tasks (not a `-P` parameter: tests lower it to check that the tree stays the same).
