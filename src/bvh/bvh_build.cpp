@@ -10,6 +10,7 @@
 
 #include "cellrt/error.hpp"
 #include "cellrt/ray.hpp"
+#include "kernel/binning.hpp"
 #include "kernel/outward.hpp"
 #include "kernel/subtree.hpp"
 
@@ -74,8 +75,6 @@ std::pair<Box3, Box3> split_reference(const Triangle& tri, const Box3& box, int 
         left.extend(crossing);
         right.extend(crossing);
     }
-    left.hi[axis] = std::min(left.hi[axis], pos);
-    right.lo[axis] = std::max(right.lo[axis], pos);
     return {intersection(left, box), intersection(right, box)};
 }
 
@@ -129,20 +128,6 @@ private:
         Box3 left_box, right_box;     // object split: the children's boxes
     };
 
-    // Bins of equal width over one axis of a box. Clamped as a float, before the conversion: a point at
-    // the box's far side gives `count`, and where the extent is subnormal, count / extent is inf and
-    // k inf or NaN, which no int holds.
-    struct AxisBins {
-        float lo, scale, last;
-        AxisBins(const Box3& range, int axis, int count)
-            : lo(range.lo[axis]), scale(static_cast<float>(count) / (range.hi[axis] - range.lo[axis])),
-              last(static_cast<float>(count - 1)) {}
-        int operator()(float x) const {
-            const float k = (x - lo) * scale;
-            return k > 0.f ? static_cast<int>(std::min(k, last)) : 0;
-        }
-    };
-
     // The cheapest binned SAH split of the references by centroid, or axis -1 when all centroids coincide.
     Split object_split(std::span<const Ref> refs, double parent, const Box3& cbox) const {
         Split best;
@@ -154,9 +139,9 @@ private:
             if (!(cbox.hi[a] > cbox.lo[a])) continue;
             std::fill_n(bin_box.begin(), o_.bins, Box3{});
             std::fill_n(bin_count.begin(), o_.bins, 0u);
-            const AxisBins bin_of(cbox, a, o_.bins);
+            const AxisBins bins(cbox.lo[a], cbox.hi[a], o_.bins);
             for (const Ref& r : refs) {
-                const int k = bin_of(r.box.center()[a]);
+                const int k = bins.bin(r.box.center()[a]);
                 bin_box[k].extend(r.box);
                 ++bin_count[k];
             }
@@ -202,9 +187,9 @@ private:
             std::fill_n(exit_box.begin(), bins, Box3{});
             std::fill_n(entries.begin(), bins, 0u);
             std::fill_n(exits.begin(), bins, 0u);
-            const AxisBins bin_of(box, a, bins);
+            const AxisBins spatial(box.lo[a], box.hi[a], bins);
             for (const Ref& r : refs) {
-                const int first = bin_of(r.box.lo[a]), last = std::max(first, bin_of(r.box.hi[a]));
+                const int first = spatial.bin(r.box.lo[a]), last = std::max(first, spatial.bin(r.box.hi[a]));
                 ++entries[first];
                 ++exits[last];
                 entry_box[first].extend(r.box);
@@ -322,9 +307,9 @@ private:
         if (!split.spatial) {
             auto mid = refs.begin() + static_cast<std::ptrdiff_t>(count / 2);  // the object median, where no SAH split applies
             if (split.axis >= 0) {
-                const AxisBins bin_of(cbox, split.axis, o_.bins);
+                const AxisBins bins(cbox.lo[split.axis], cbox.hi[split.axis], o_.bins);
                 mid = std::partition(refs.begin(), refs.end(),
-                                     [&](const Ref& r) { return bin_of(r.box.center()[split.axis]) < split.bin; });
+                                     [&](const Ref& r) { return bins.bin(r.box.center()[split.axis]) < split.bin; });
             }
             left.assign(refs.begin(), mid);
             right.assign(mid, refs.end());

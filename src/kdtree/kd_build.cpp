@@ -33,6 +33,7 @@
 #include <tbb/task_group.h>
 
 #include "cellrt/error.hpp"
+#include "kernel/binning.hpp"
 #include "kernel/subtree.hpp"
 #include "kd_clip.hpp"
 #include "kd_event.hpp"
@@ -107,18 +108,6 @@ struct Scratch {
     std::array<std::array<std::vector<Event>, 2>, kKdMaxDepth + 1> children_events;
     std::vector<std::uint32_t> starts, ends;  // histograms, per axis
     std::vector<Event> events;                // the bounded search's gathered events of one axis
-};
-
-// Min-max bins of one axis over [lo, lo + bins / scale]: bin(x) is monotone in x, so a box starting
-// in a lower bin than a candidate starts before it, and one ending in a higher bin ends after it.
-struct AxisBins {
-    float lo = 0.f, scale = 0.f;  // scale 0: one bin holds everything
-    int count = 1;
-    // Where hi - lo is subnormal, scale is inf and the product inf or NaN, which no int holds.
-    int bin(float x) const {
-        const float k = (x - lo) * scale;
-        return k > 0.f ? static_cast<int>(std::min(k, static_cast<float>(count - 1))) : 0;
-    }
 };
 
 // The exact search's bins of one axis: the first holds what lies at or below the cell's low plane,
@@ -340,15 +329,8 @@ private:
     // Bins of `bins` per axis over the references' tight bounds (an axis without extent: one bin).
     static std::array<AxisBins, 3> axis_bins(const Work& w, int bins) {
         const Box3 tight = intersection(w.bounds, w.cell);
-        std::array<AxisBins, 3> out;
-        for (int a = 0; a < 3; ++a) {
-            const float lo = tight.lo[a], hi = tight.hi[a];
-            out[a].lo = lo;
-            if (!(lo < hi)) continue;
-            out[a].scale = static_cast<float>(bins) / (hi - lo);
-            out[a].count = bins;
-        }
-        return out;
+        return {AxisBins(tight.lo[0], tight.hi[0], bins), AxisBins(tight.lo[1], tight.hi[1], bins),
+                AxisBins(tight.lo[2], tight.hi[2], bins)};
     }
 
     // Per axis, how many reference boxes start and end in each bin: scratch.starts and .ends hold
