@@ -492,6 +492,9 @@ private:
         }
     }
 
+    // What an event adds to a run's count of ends (low half) and starts (high half), by type.
+    static constexpr std::uint64_t kRunCount[3] = {1, 0, std::uint64_t{1} << 32};  // kEnd, kPlanar, kStart
+
     // One position of the sweep (W&H section 4.3): the run of events from ev[i] at one position and
     // class, after which `i` points. Its ends and planars leave the right side, the plane is offered
     // with the planars on either side, then its starts and planars join the left side. Inlined: it is
@@ -500,14 +503,16 @@ private:
                                                       float hi, const SahCost& sah, SplitSearch& search,
                                                       std::ptrdiff_t& nl, std::ptrdiff_t& nr) {
         const std::size_t first = i;
-        const std::uint32_t at = ev[i].position_class();
-        std::ptrdiff_t leaving = 0, planars = 0, joining = 0;  // ends and planars, planars, starts and planars
-        do {
-            const std::uint32_t t = ev[i].type();  // kEnd 0, kPlanar 1, kStart 2
-            leaving += (t ^ 2) >> 1;
-            planars += t & 1;
-            joining += (t + 1) >> 1;
-        } while (++i < ev.size() && ev[i].position_class() == at);
+        const Event run_end = ev[i].next_position();
+        // The run's ends and starts counted in one word, ends in the low half, starts in the high
+        // (a list holds fewer than 2^32 events); the planars are the rest of the run.
+        std::uint64_t counts = 0;
+        do counts += kRunCount[ev[i].type()];
+        while (++i < ev.size() && ev[i] < run_end);
+        const auto ends = static_cast<std::ptrdiff_t>(counts & 0xffffffffu);
+        const auto starts = static_cast<std::ptrdiff_t>(counts >> 32);
+        const auto planars = static_cast<std::ptrdiff_t>(i - first) - ends - starts;
+        const std::ptrdiff_t leaving = ends + planars, joining = starts + planars;
         nr -= leaving;
         const float pos = ev[first].pos();
         if (lo < pos && pos < hi) {
@@ -660,11 +665,13 @@ private:
         std::vector<std::uint32_t>& straddling = scratch.straddling_storage;
         if (straddling.size() < events.size()) straddling.resize(events.size());
         const auto nowhere = static_cast<std::uint32_t>(side.size() - 1);
+        // Positions compared as their integer classes, which order finite floats as the floats do.
+        const std::uint32_t plane = Event(s.pos, kEnd, 0).position_class();
         std::size_t nl = 0, nr = 0, straddlers = 0;
         for (const Event e : events) {
-            const float pos = e.pos();
+            const std::uint32_t pos = e.position_class();
             const std::uint32_t t = e.triangle();
-            const std::size_t where = 1 + std::size_t{pos > s.pos} - std::size_t{pos < s.pos};
+            const std::size_t where = 1 + std::size_t{pos > plane} - std::size_t{pos < plane};
             const Side decided = decides[where][e.type()];
             straddling[straddlers] = t;
             straddlers += std::size_t{e.type() == kEnd} & std::size_t{where == 2} & std::size_t{side[t] == Side::both};
@@ -704,20 +711,66 @@ private:
         return {reaching[0], reaching[1]};
     }
 
-    // Sorts the few events a split adds to one list. Short lists are sorted by rank (an event's
-    // place is the number of smaller events): no branch, unlike the unpredictable loop exits of
-    // the insertion sort std::sort uses there.
+    // Sorts the few events a split adds to one list (most hold 2 to 16). Lists of up to 32 are
+    // padded with sentinels to a power of two and sorted by Batcher's odd-even merge network
+    // (Knuth, TAOCP vol. 3, section 5.3.4): a fixed sequence of compare-exchanges, each a minimum
+    // and a maximum without a branch, unlike the unpredictable loop exits of the insertion sort
+    // std::sort uses there. No two events of a list are equal, so every sort gives the same list.
     static void sort_events(std::span<Event> list) {
-        constexpr std::size_t kByRank = 32;
+        constexpr std::size_t kByNetwork = 32;
         const std::size_t n = list.size();
-        if (n > kByRank) return std::sort(list.begin(), list.end());
-        Event unsorted[kByRank];
-        std::copy_n(list.begin(), n, unsorted);
-        for (std::size_t i = 0; i < n; ++i) {
-            std::size_t rank = 0;
-            for (std::size_t j = 0; j < n; ++j) rank += unsorted[j] < unsorted[i];
-            list[rank] = unsorted[i];
+        if (n <= 1) return;
+        if (n > kByNetwork) return std::sort(list.begin(), list.end());
+        Event block[kByNetwork];
+        std::copy_n(list.begin(), n, block);
+        const std::size_t size = std::bit_ceil(n);
+        std::fill(block + n, block + size, Event::sentinel());
+        switch (size) {
+            case 2: sort_network<2>(block); break;
+            case 4: sort_network<4>(block); break;
+            case 8: sort_network<8>(block); break;
+            case 16: sort_network<16>(block); break;
+            default: sort_network<32>(block); break;
         }
+        std::copy_n(block, n, list.begin());
+    }
+
+    // Batcher's odd-even merge sort of n = 2^k events, unrolled at compile time into a straight
+    // sequence of compare-exchanges between fixed slots (network_pairs below).
+    template <std::size_t n>
+    static void sort_network(Event* e) {
+        static constexpr auto pairs = network_pairs<n>();
+        [&]<std::size_t... i>(std::index_sequence<i...>) {
+            (compare_exchange(e[pairs[i].first], e[pairs[i].second]), ...);
+        }(std::make_index_sequence<pairs.size()>{});
+    }
+    [[gnu::always_inline]] static void compare_exchange(Event& x, Event& y) {
+        const Event a = x, b = y;
+        const bool swap = b < a;
+        x = swap ? b : a;
+        y = swap ? a : b;
+    }
+    // The network's compare-exchanges in order: runs of p, 2p, ... merged (Knuth's algorithm M).
+    template <std::size_t n>
+    static constexpr std::size_t network_size() {
+        std::size_t count = 0;
+        for (std::size_t p = 1; p < n; p += p)
+            for (std::size_t k = p; k >= 1; k /= 2)
+                for (std::size_t j = k % p; j + k < n; j += 2 * k)
+                    for (std::size_t i = 0; i < k && i + j + k < n; ++i) count += (i + j) / (2 * p) == (i + j + k) / (2 * p);
+        return count;
+    }
+    template <std::size_t n>
+    static constexpr auto network_pairs() {
+        std::array<std::pair<std::uint8_t, std::uint8_t>, network_size<n>()> out{};
+        std::size_t count = 0;
+        for (std::size_t p = 1; p < n; p += p)
+            for (std::size_t k = p; k >= 1; k /= 2)
+                for (std::size_t j = k % p; j + k < n; j += 2 * k)
+                    for (std::size_t i = 0; i < k && i + j + k < n; ++i)
+                        if ((i + j) / (2 * p) == (i + j + k) / (2 * p))
+                            out[count++] = {static_cast<std::uint8_t>(i + j), static_cast<std::uint8_t>(i + j + k)};
+        return out;
     }
 
     // Per axis, every event of a one-sided triangle goes to its child, leaving room in front for

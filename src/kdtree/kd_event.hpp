@@ -43,6 +43,14 @@ public:
     std::uint32_t triangle() const { return key() & kTriangleMask; }
     friend bool operator<(Event a, Event b) { return a.bits_ < b.bits_; }
 
+    // The least event past every event at this one's position (-0 and +0 being one position): in a
+    // sorted list, the events at this position are those from it up to, not including, this bound.
+    Event next_position() const {
+        Event e;
+        e.bits_ = (std::uint64_t{position_class()} + 1) << 32;
+        return e;
+    }
+
     // Greater than every event (their positions are finite): ends a list for a merge without bounds checks.
     static Event sentinel() {
         Event e;
