@@ -1,11 +1,11 @@
 #!/bin/sh
 # The BVH's spatial-split reach rule (docs/BVH.md, "Build"), measured. OLD and NEW are two checkouts'
-# build folders; build_hash.cpp is linked once with each one's src/bvh/bvh_build.cpp.
+# build folders; docs/figures/tree_hash.cpp is linked once with each one's src/bvh/bvh_build.cpp.
 # 1. Instructions of the build, tree hash, SAH cost, references (callgrind.txt):
-#    g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 build_hash.cpp src/bvh/bvh_build.cpp \
-#        build/libcellrt.a -ltbb -lembree3 -o bvh_hash
+#    g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 docs/figures/tree_hash.cpp src/bvh/bvh_build.cpp \
+#        build/libcellrt.a -ltbb -lembree3 -o tree_hash
 #    valgrind --tool=callgrind --callgrind-out-file=/dev/null --toggle-collect='cellrt::detail::build_bvh*' \
-#        ./bvh_hash SCENE 1
+#        ./tree_hash bvh SCENE 1 1
 # 2. Build time beside Embree's, the binaries in turn, three rounds (b_old_N.json, b_new_N.json):
 set -e
 for r in 1 2 3; do

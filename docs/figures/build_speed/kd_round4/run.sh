@@ -1,10 +1,10 @@
 #!/bin/sh
 # The kd-tree builder's fourth round (docs/BUILD_SPEED.md), measured. OLD and NEW: two checkouts.
-# 1. Tree bytes and instructions: build_hash.cpp linked once with each checkout's kd_build.cpp
-#      g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 build_hash.cpp src/kdtree/kd_build.cpp \
-#          build/libcellrt.a -ltbb -lembree3 -o kd_hash
-#      ./kd_hash SCENE REPEATS THREADS [CLIP_RATIO MAX_BAD_REFINES]      # prints nodes, hash, best ms
-#      valgrind --tool=callgrind --callgrind-out-file=/dev/null --toggle-collect='cellrt::detail::build_*' ./kd_hash SCENE 1 1
+# 1. Tree bytes and instructions: docs/figures/tree_hash.cpp linked once with each checkout's kd_build.cpp
+#      g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 docs/figures/tree_hash.cpp src/kdtree/kd_build.cpp \
+#          build/libcellrt.a -ltbb -lembree3 -o tree_hash
+#      ./tree_hash kd SCENE REPEATS THREADS [CLIP_RATIO MAX_BAD_REFINES]      # prints nodes, hash, best ms
+#      valgrind --tool=callgrind --callgrind-out-file=/dev/null --toggle-collect='cellrt::detail::build_*' ./tree_hash kd SCENE 1 1
 # 2. float_below/above against their earlier definitions: g++ -O2 -std=c++20 -I src outward_check.cpp && ./a.out
 # 3. The events' sort alone, rank against network, on Sponza's list sizes: g++ -O3 -std=c++20 sort_bench.cpp && ./a.out
 # 4. Build time beside Embree's, the binaries in turn, three rounds (kd_old_N.json, kd_new_N.json):
