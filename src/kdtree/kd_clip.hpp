@@ -2,6 +2,7 @@
 // precision, its box rounded outward to floats, so that child boxes are tight and still conservative.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -23,11 +24,18 @@ public:
         v[0] = {t.v0.x, t.v0.y, t.v0.z};
         v[1] = {t.v1.x, t.v1.y, t.v1.z};
         v[2] = {t.v2.x, t.v2.y, t.v2.z};
+        n_ = 3;
     }
     ClippedPolygon(const ClippedPolygon& other) : n_(other.n_) {
         std::copy_n(other.buffers_[other.current_], kMaxVertices, buffers_[0]);
     }
-    ClippedPolygon& operator=(const ClippedPolygon&) = delete;
+    ClippedPolygon& operator=(const ClippedPolygon& other) {
+        n_ = other.n_;
+        current_ = 0;
+        std::copy_n(other.buffers_[other.current_], kMaxVertices, buffers_[0]);
+        return *this;
+    }
+    ClippedPolygon() = default;  // empty, for split() to fill
 
     // Keeps the part with c[a] >= plane (`keep_above`) or c[a] <= plane.
     template <bool keep_above>
@@ -59,6 +67,43 @@ public:
         n_ = m;
         current_ ^= 1;
     }
+    // clip<true>(a, plane) of this polygon, and clip<false>(a, plane) of it written to `below`, in
+    // one pass: each edge's crossing is computed once for both sides, with the same operands and so
+    // the same bits as either clip would give it. (A side that keeps every vertex gets them all, in
+    // order: the polygon a clip that returns early leaves.)
+    void split(int a, double plane, ClippedPolygon& below) {
+        const P* v = buffers_[current_];
+        bool above_in[kMaxVertices], below_in[kMaxVertices];
+        for (int i = 0; i < n_; ++i) {
+            above_in[i] = v[i].c[a] >= plane;
+            below_in[i] = v[i].c[a] <= plane;
+        }
+        P* kept_above = buffers_[current_ ^ 1];
+        P* kept_below = below.buffers_[0];
+        int m_above = 0, m_below = 0;
+        for (int i = 0; i < n_; ++i) {
+            const int j = i + 1 == n_ ? 0 : i + 1;
+            const P& cur = v[i];
+            const P& nxt = v[j];
+            kept_above[m_above] = cur;
+            m_above += above_in[i];
+            kept_below[m_below] = cur;
+            m_below += below_in[i];
+            const double s = (plane - cur.c[a]) / (nxt.c[a] - cur.c[a]);
+            P x;
+            for (int k = 0; k < 3; ++k) x.c[k] = cur.c[k] + s * (nxt.c[k] - cur.c[k]);
+            x.c[a] = plane;
+            kept_above[m_above] = x;
+            m_above += above_in[i] != above_in[j];
+            kept_below[m_below] = x;
+            m_below += below_in[i] != below_in[j];
+        }
+        below.n_ = m_below;
+        below.current_ = 0;
+        n_ = m_above;
+        current_ ^= 1;
+    }
+
     // Clips to the slab of `cell` on axis `a`, skipping a plane that the triangle's box `inside` lies
     // strictly within: it cuts no vertex. (Vertices made by earlier cuts may stray from that box by a
     // few roundings in double, far less than the float step between box and plane unless coordinates
@@ -92,7 +137,7 @@ private:
     };
     P buffers_[2][kMaxVertices + 1];  // one spare slot for the last unconditional write
     int current_ = 0;
-    int n_ = 3;
+    int n_ = 0;
 };
 
 // Bounds of the parts of `tri` in the two children of `cell` split at `pos` on `axis`: each is the
@@ -103,11 +148,19 @@ inline std::pair<Box3, Box3> clipped_child_bounds(const Triangle& tri, const Box
     Box3 lcell = cell, rcell = cell;
     lcell.hi[axis] = rcell.lo[axis] = pos;
     const Box3 inside = tri.bounds();
-    ClippedPolygon left(tri);
-    for (int a = 0; a < axis; ++a) left.clip_to_slab(a, cell, inside);
-    ClippedPolygon right = left;
-    left.clip_to_slab(axis, lcell, inside);
-    right.clip_to_slab(axis, rcell, inside);
+    ClippedPolygon right(tri);
+    for (int a = 0; a < axis; ++a) right.clip_to_slab(a, cell, inside);
+    ClippedPolygon left;
+    if (inside.lo[axis] > cell.lo[axis] && !(inside.lo[axis] > pos) && !(inside.hi[axis] < pos)) {
+        // The left side's first cut on the split axis is the plane, as the right side's is: one
+        // pass for both (the common case: a straddler that does not reach the cell's low plane).
+        right.split(axis, pos, left);
+        if (!(inside.hi[axis] < cell.hi[axis])) right.clip<false>(axis, cell.hi[axis]);
+    } else {
+        left = right;
+        left.clip_to_slab(axis, lcell, inside);
+        right.clip_to_slab(axis, rcell, inside);
+    }
     for (int a = axis + 1; a < 3; ++a) {
         left.clip_to_slab(a, cell, inside);
         right.clip_to_slab(a, cell, inside);

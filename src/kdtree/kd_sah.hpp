@@ -14,13 +14,15 @@ namespace cellrt::detail::kdbuild {
 // surface areas over the parent's, from two per-axis factors precomputed per cell.
 class SahCost {
 public:
-    SahCost(const Box3& cell, const KdBuildParams& p) : cell_(cell), p_(p) {
+    SahCost(const Box3& cell, const KdBuildParams& p) : p_(p), empty_factor_(1.0 - p.empty_bonus) {
         const double e[3] = {double(cell.hi.x) - cell.lo.x, double(cell.hi.y) - cell.lo.y,
                              double(cell.hi.z) - cell.lo.z};
         for (int a = 0; a < 3; ++a) {
             const double b = e[(a + 1) % 3], c = e[(a + 2) % 3];
             constant_[a] = b * c;
             linear_[a] = b + c;
+            lo_[a] = cell.lo[a];
+            hi_[a] = cell.hi[a];
         }
         half_area_ = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
         scaled_reciprocal_ = p.intersection_cost / half_area_;
@@ -29,12 +31,12 @@ public:
     double leaf(std::size_t n) const { return p_.intersection_cost * static_cast<double>(n); }
     // Half the surface areas of the two children: the numerators of their probabilities.
     std::pair<double, double> areas(int a, float pos) const {
-        const double wl = double(pos) - cell_.lo[a], wr = double(cell_.hi[a]) - pos;
+        const double wl = double(pos) - lo_[a], wr = hi_[a] - pos;
         return {constant_[a] + wl * linear_[a], constant_[a] + wr * linear_[a]};
     }
     // areas() at any point x of the axis, for bounds of the cost between candidates.
     std::pair<double, double> areas_at(int a, double x) const {
-        const double wl = x - cell_.lo[a], wr = double(cell_.hi[a]) - x;
+        const double wl = x - lo_[a], wr = hi_[a] - x;
         return {constant_[a] + wl * linear_[a], constant_[a] + wr * linear_[a]};
     }
     // Probabilities that a ray through the cell passes through the left and the right child.
@@ -60,11 +62,12 @@ public:
 
 private:
     double with_bonus(double cost, std::ptrdiff_t nl, std::ptrdiff_t nr) const {
-        return nl == 0 || nr == 0 ? cost * (1.0 - p_.empty_bonus) : cost;
+        return nl == 0 || nr == 0 ? cost * empty_factor_ : cost;
     }
 
-    Box3 cell_;
     const KdBuildParams& p_;
+    double empty_factor_;  // 1 - empty_bonus
+    double lo_[3], hi_[3];  // the cell's planes
     double constant_[3], linear_[3], half_area_, scaled_reciprocal_;
 };
 
