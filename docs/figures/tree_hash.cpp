@@ -1,15 +1,16 @@
-// Builds a kd-tree or a wide BVH of a scene and prints an FNV-1a hash of the tree's bytes, its size
+// Builds a kd-tree, a BIH or a wide BVH of a scene and prints an FNV-1a hash of the tree's bytes, its size
 // and the best build time: the check that a builder's refactor keeps its trees. Linked once with
-// each checkout's builder, e.g. (for the kd-tree; src/bvh/bvh_build.cpp for the BVH):
-//   g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 docs/figures/tree_hash.cpp \
+// each checkout's builder, e.g. (for the kd-tree; src/bih/bih_build.cpp, src/bvh/bvh_build.cpp):
+//   g++ -I include -I src -O3 -DNDEBUG -ffp-contract=off -std=c++20 docs/figures/tree_hash.cpp
 //       src/kdtree/kd_build.cpp build/libcellrt.a -ltbb -lembree3 -o tree_hash
-//   ./tree_hash kd|bvh SCENE REPEATS THREADS [clip_ratio max_bad_refines | split_budget]
+//   ./tree_hash kd|bih|bih-sah|bvh SCENE REPEATS THREADS [clip_ratio max_bad_refines | split_budget]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "bih/bih_tree.hpp"
 #include "bvh/bvh_build.hpp"
 #include "cellrt/scene.hpp"
 #include "kdtree/kd_tree.hpp"
@@ -34,7 +35,7 @@ static double best_of(int repeats, Build&& build) {
 }
 
 int main(int argc, char** argv) {
-    if (argc < 5) return std::fprintf(stderr, "usage: tree_hash kd|bvh SCENE REPEATS THREADS [params]\n"), 2;
+    if (argc < 5) return std::fprintf(stderr, "usage: tree_hash kd|bih|bih-sah|bvh SCENE REPEATS THREADS [params]\n"), 2;
     const std::string kind = argv[1];
     const Scene scene = load_scene(argv[2]);
     const int repeats = std::atoi(argv[3]);
@@ -46,6 +47,14 @@ int main(int argc, char** argv) {
         detail::KdTree t;
         const double ms = best_of(repeats, [&] { t = detail::build_kdtree(scene.triangles, p); });
         const std::uint64_t h = fnv(t.indices.data(), t.indices.size() * 4, fnv(t.nodes.data(), t.nodes.size() * sizeof(t.nodes[0])));
+        std::printf("%s nodes %zu hash %016llx min_ms %.1f\n", argv[2], t.nodes.size(), (unsigned long long)h, ms);
+    } else if (kind == "bih" || kind == "bih-sah") {
+        detail::BihBuildParams p;
+        p.threads = threads;
+        if (kind == "bih-sah") p.split = detail::BihSplit::sah;
+        detail::BihTree t;
+        const double ms = best_of(repeats, [&] { t = detail::build_bih(scene.triangles, p); });
+        const std::uint64_t h = fnv(t.prims.data(), t.prims.size() * 4, fnv(t.nodes.data(), t.nodes.size() * sizeof(t.nodes[0])));
         std::printf("%s nodes %zu hash %016llx min_ms %.1f\n", argv[2], t.nodes.size(), (unsigned long long)h, ms);
     } else {
         detail::BvhBuildOptions o;

@@ -38,6 +38,7 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
+#include "kernel/box_lanes.hpp"
 #include "kernel/subtree.hpp"
 #include "bih_tree.hpp"
 
@@ -107,32 +108,9 @@ struct Item {
 };
 static_assert(sizeof(Item) == 28 && offsetof(Item, box.hi) == 12);
 
-// Four floats (x, y, z and a spare lane), GCC's and Clang's generic vectors: SSE on x86-64, what the
-// target has elsewhere. Per triangle, the builder's passes do the three axes' arithmetic at once.
-typedef float F4 __attribute__((vector_size(16)));
-typedef std::int32_t I4 __attribute__((vector_size(16)));
-
-// The item's box corners, read as one unaligned load each; the lane past z is the next field (hi.x
-// for `lo`, the index for `hi`, zeroed: its bits could be a denormal, which is slow to add).
-F4 lo_of(const Item& t) {
-    F4 v;
-    std::memcpy(&v, &t, sizeof v);
-    return v;
-}
-F4 hi_of(const Item& t) {
-    F4 v;
-    std::memcpy(&v, reinterpret_cast<const char*>(&t) + offsetof(Item, box.hi), sizeof v);
-    return std::bit_cast<F4>(std::bit_cast<I4>(v) & I4{-1, -1, -1, 0});
-}
-// Box3::center's arithmetic, so the same bits.
-F4 centre_of(const Item& t) { return (lo_of(t) + hi_of(t)) * 0.5f; }
-
-// The SAH bin of a centre on each axis: (c - origin) * scale, at most kSahBins - 1, truncated. The
-// origin is the least centre of the node, so the product is never negative.
-I4 bins_of(F4 centre, F4 origin, F4 scale) {
-    const F4 x = (centre - origin) * scale, last = F4{} + float(kSahBins - 1);
-    return __builtin_convertvector(last < x ? last : x, I4);
-}
+// The SAH bin of a centre on each axis (kernel/box_lanes.hpp). The origin is the least centre of the
+// node, so the product is never negative.
+I4 bins_of(F4 centre, F4 origin, F4 scale) { return lane_bins(centre, origin, scale, F4{} + float(kSahBins - 1)); }
 
 // The order in which a pass meets the triangles of a range: by ascending or descending position.
 enum class Order { ascending, descending };
@@ -146,7 +124,7 @@ struct Bounds {
 
     template <Order order>
     void take(const Item& t) {
-        const F4 l = lo_of(t), h = hi_of(t), c = (l + h) * 0.5f;
+        const F4 l = lanes_lo(t), h = lanes_hi(t), c = (l + h) * 0.5f;
         lo = lower<order>(lo, l);
         hi = higher<order>(hi, h);
         centre_lo = lower<order>(centre_lo, c);
@@ -189,7 +167,7 @@ struct Bins {
     // One pass bins all three axes, the centres' bins computed for the three at once.
     void add(std::span<const Item> items, F4 origin, F4 scale) {
         for (const Item& t : items) {
-            const I4 k = bins_of(centre_of(t), origin, scale);
+            const I4 k = bins_of(lanes_centre(t), origin, scale);
             for (int a = 0; a < 3; ++a) {
                 ++count[a][k[a]];
                 occupied[a] |= 1u << k[a];
@@ -430,7 +408,7 @@ private:
         const bool leaf_is_cheaper = !(best_cost < p_.intersection_cost * r.size());
         if (best_axis < 0 || (leaf_is_cheaper && r.size() <= static_cast<std::uint32_t>(p_.sah_max_leaf)))
             return Decision{};
-        return split_at(r, best_axis, [&](const Item& t) { return bins_of(centre_of(t), origin, scale)[best_axis] <= best_bin; });
+        return split_at(r, best_axis, [&](const Item& t) { return bins_of(lanes_centre(t), origin, scale)[best_axis] <= best_bin; });
     }
 
     // The range's bins. In parallel builds a range of parallel_pass_min triangles or more is binned by

@@ -13,6 +13,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/ray.hpp"
 #include "kernel/binning.hpp"
+#include "kernel/box_lanes.hpp"
 #include "kernel/subtree.hpp"
 
 namespace cellrt::detail {
@@ -52,6 +53,44 @@ struct BinaryNode {
     std::uint32_t left = 0, right = 0;  // inner
     std::uint32_t first = 0, count = 0;  // leaf: its triangles in `order`
     bool leaf = false;
+};
+
+// Per axis and bin, how many references a binning put there and the bounds of their boxes, kept as
+// Box3::extend keeps them (minps and maxps in its operand order: an equal value keeps the bound), for
+// binning passes that place each reference on the three axes at once (kernel/box_lanes.hpp).
+struct LaneBoxBins {
+    std::array<std::array<F4, 256>, 3> lo, hi;
+    std::array<std::array<std::uint32_t, 256>, 3> count;
+
+    explicit LaneBoxBins(int bins) {
+        for (int a = 0; a < 3; ++a) {
+            std::fill_n(lo[a].begin(), bins, F4{} + kInfinity);
+            std::fill_n(hi[a].begin(), bins, F4{} - kInfinity);
+            std::fill_n(count[a].begin(), bins, 0u);
+        }
+    }
+    void add(int a, int k, F4 l, F4 h) {
+        F4& bl = lo[a][k];
+        F4& bh = hi[a][k];
+        bl = l < bl ? l : bl;
+        bh = bh < h ? h : bh;
+        ++count[a][k];
+    }
+    Box3 box(int a, int k) const { return {{lo[a][k][0], lo[a][k][1], lo[a][k][2]}, {hi[a][k][0], hi[a][k][1], hi[a][k][2]}}; }
+};
+
+// The bins of `box` on each axis as AxisBins makes them (`bins` over the extent, or one bin where
+// there is none): origins, scales and the last bin, one lane per axis.
+struct LaneAxes {
+    F4 origin{}, scale{}, last{};
+    LaneAxes(const Box3& box, int bins) : last(F4{} + static_cast<float>(bins - 1)) {
+        for (int a = 0; a < 3; ++a) {
+            const AxisBins axis(box.lo[a], box.hi[a], bins);
+            origin[a] = axis.lo;
+            scale[a] = axis.scale;
+        }
+    }
+    I4 bins_of(F4 x) const { return lane_bins_guarded(x, origin, scale, last); }
 };
 
 // Whether some reference spans kSpatialReach of `box` on an axis along which the box has an extent.
@@ -122,33 +161,32 @@ private:
     // The cheapest binned SAH split of the references by centroid, or axis -1 when all centroids coincide.
     Split object_split(std::span<const Ref> refs, double parent, const Box3& cbox) const {
         Split best;
-        std::array<Box3, 256> bin_box;
-        std::array<std::uint32_t, 256> bin_count;
+        const int bins = o_.bins;
+        // One pass bins the three axes, each centre's three bins computed at once.
+        const LaneAxes axes(cbox, bins);
+        LaneBoxBins binned(bins);
+        for (const Ref& r : refs) {
+            const F4 lo = lanes_lo(r), hi = lanes_hi(r);
+            const I4 k = axes.bins_of((lo + hi) * 0.5f);
+            for (int a = 0; a < 3; ++a) binned.add(a, k[a], lo, hi);
+        }
         std::array<Box3, 256> right_box;
         std::array<std::uint32_t, 256> right_count;
         for (int a = 0; a < 3; ++a) {
             if (!(cbox.hi[a] > cbox.lo[a])) continue;
-            std::fill_n(bin_box.begin(), o_.bins, Box3{});
-            std::fill_n(bin_count.begin(), o_.bins, 0u);
-            const AxisBins bins(cbox.lo[a], cbox.hi[a], o_.bins);
-            for (const Ref& r : refs) {
-                const int k = bins.bin(r.box.center()[a]);
-                bin_box[k].extend(r.box);
-                ++bin_count[k];
-            }
             Box3 acc;
             std::uint32_t n = 0;
-            for (int k = o_.bins - 1; k > 0; --k) {  // right side of a split before bin k
-                acc.extend(bin_box[k]);
-                n += bin_count[k];
+            for (int k = bins - 1; k > 0; --k) {  // right side of a split before bin k
+                acc.extend(binned.box(a, k));
+                n += binned.count[a][k];
                 right_box[k] = acc;
                 right_count[k] = n;
             }
             acc = Box3{};
             n = 0;
-            for (int k = 1; k < o_.bins; ++k) {
-                acc.extend(bin_box[k - 1]);
-                n += bin_count[k - 1];
+            for (int k = 1; k < bins; ++k) {
+                acc.extend(binned.box(a, k - 1));
+                n += binned.count[a][k - 1];
                 if (n == 0 || right_count[k] == 0) continue;
                 const double c = split_cost(acc, n, right_box[k], right_count[k], parent);
                 if (best.axis < 0 || c < best.cost) best = {a, k, c, false, 0.f, acc, right_box[k]};
@@ -167,30 +205,30 @@ private:
     // The cheapest plane between bins whose extra references fit in `budget`; axis -1 when none does.
     Split spatial_split(std::span<const Ref> refs, double parent, const Box3& box, double budget) const {
         Split best;
-        std::array<Box3, 256> entry_box, exit_box, right_box;
-        std::array<std::uint32_t, 256> entries, exits, right_count;
         const int bins = o_.bins;
+        // One pass bins the three axes: each reference's entry and exit bins on all three at once.
+        const LaneAxes axes(box, bins);
+        LaneBoxBins entry(bins), exit(bins);
+        for (const Ref& r : refs) {
+            const F4 lo = lanes_lo(r), hi = lanes_hi(r);
+            const I4 first = axes.bins_of(lo), to = axes.bins_of(hi);
+            const I4 last = to < first ? first : to;
+            for (int a = 0; a < 3; ++a) {
+                entry.add(a, first[a], lo, hi);
+                exit.add(a, last[a], lo, hi);
+            }
+        }
+        std::array<Box3, 256> right_box;
+        std::array<std::uint32_t, 256> right_count;
         for (int a = 0; a < 3; ++a) {
             if (!(box.hi[a] > box.lo[a])) continue;
             const float width = (box.hi[a] - box.lo[a]) / static_cast<float>(bins);
             const auto plane = [&](int k) { return box.lo[a] + width * static_cast<float>(k); };
-            std::fill_n(entry_box.begin(), bins, Box3{});
-            std::fill_n(exit_box.begin(), bins, Box3{});
-            std::fill_n(entries.begin(), bins, 0u);
-            std::fill_n(exits.begin(), bins, 0u);
-            const AxisBins spatial(box.lo[a], box.hi[a], bins);
-            for (const Ref& r : refs) {
-                const int first = spatial.bin(r.box.lo[a]), last = std::max(first, spatial.bin(r.box.hi[a]));
-                ++entries[first];
-                ++exits[last];
-                entry_box[first].extend(r.box);
-                exit_box[last].extend(r.box);
-            }
             Box3 acc;
             std::uint32_t n = 0;
             for (int k = bins - 1; k > 0; --k) {  // right of the plane before bin k
-                acc.extend(exit_box[k]);
-                n += exits[k];
+                acc.extend(exit.box(a, k));
+                n += exit.count[a][k];
                 right_box[k] = acc;
                 right_box[k].lo[a] = std::max(acc.lo[a], plane(k));
                 right_count[k] = n;
@@ -198,8 +236,8 @@ private:
             acc = Box3{};
             n = 0;
             for (int k = 1; k < bins; ++k) {
-                acc.extend(entry_box[k - 1]);
-                n += entries[k - 1];
+                acc.extend(entry.box(a, k - 1));
+                n += entry.count[a][k - 1];
                 if (n == 0 || right_count[k] == 0) continue;
                 if (static_cast<double>(n + right_count[k] - refs.size()) > budget) continue;
                 Box3 left = acc;
