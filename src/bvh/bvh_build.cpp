@@ -55,28 +55,41 @@ struct BinaryNode {
     bool leaf = false;
 };
 
-// Per axis and bin, how many references a binning put there and the bounds of their boxes, kept as
-// Box3::extend keeps them (minps and maxps in its operand order: an equal value keeps the bound), for
+// A box in lanes, extended as Box3::extend extends (minps and maxps in its operand order: an equal
+// value keeps the bound) and measured with Box3::area's arithmetic, so the same bits. No member
+// initializers: arrays of them are filled as far as they are used.
+struct LaneBox {
+    F4 lo, hi;
+
+    static LaneBox empty() { return {F4{} + kInfinity, F4{} - kInfinity}; }
+    void extend(const LaneBox& b) {
+        lo = b.lo < lo ? b.lo : lo;
+        hi = hi < b.hi ? b.hi : hi;
+    }
+    Box3 box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+    double area() const {
+        if (lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]) return 0.0;
+        const F4 e = hi - lo;
+        return static_cast<double>(2.f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]));
+    }
+};
+
+// Per axis and bin, how many references a binning put there and the bounds of their boxes, for
 // binning passes that place each reference on the three axes at once (kernel/box_lanes.hpp).
 struct LaneBoxBins {
-    std::array<std::array<F4, 256>, 3> lo, hi;
+    std::array<std::array<LaneBox, 256>, 3> box;
     std::array<std::array<std::uint32_t, 256>, 3> count;
 
     explicit LaneBoxBins(int bins) {
         for (int a = 0; a < 3; ++a) {
-            std::fill_n(lo[a].begin(), bins, F4{} + kInfinity);
-            std::fill_n(hi[a].begin(), bins, F4{} - kInfinity);
+            std::fill_n(box[a].begin(), bins, LaneBox::empty());
             std::fill_n(count[a].begin(), bins, 0u);
         }
     }
-    void add(int a, int k, F4 l, F4 h) {
-        F4& bl = lo[a][k];
-        F4& bh = hi[a][k];
-        bl = l < bl ? l : bl;
-        bh = bh < h ? h : bh;
+    void add(int a, int k, const LaneBox& b) {
+        box[a][k].extend(b);
         ++count[a][k];
     }
-    Box3 box(int a, int k) const { return {{lo[a][k][0], lo[a][k][1], lo[a][k][2]}, {hi[a][k][0], hi[a][k][1], hi[a][k][2]}}; }
 };
 
 // The bins of `box` on each axis as AxisBins makes them (`bins` over the extent, or one bin where
@@ -145,8 +158,8 @@ public:
 private:
     // Leaf tests, in groups of eight lanes.
     double leaf_cost(std::size_t n) const { return o_.intersection_cost * double((n + kBvhWidth - 1) / kBvhWidth); }
-    double split_cost(const Box3& l, std::size_t nl, const Box3& r, std::size_t nr, double parent) const {
-        return o_.traversal_cost + (area(l) * leaf_cost(nl) + area(r) * leaf_cost(nr)) / parent;
+    double split_cost(double left_area, std::size_t nl, double right_area, std::size_t nr, double parent) const {
+        return o_.traversal_cost + (left_area * leaf_cost(nl) + right_area * leaf_cost(nr)) / parent;
     }
 
     struct Split {
@@ -166,30 +179,30 @@ private:
         const LaneAxes axes(cbox, bins);
         LaneBoxBins binned(bins);
         for (const Ref& r : refs) {
-            const F4 lo = lanes_lo(r), hi = lanes_hi(r);
-            const I4 k = axes.bins_of((lo + hi) * 0.5f);
-            for (int a = 0; a < 3; ++a) binned.add(a, k[a], lo, hi);
+            const LaneBox b{lanes_lo(r), lanes_hi(r)};
+            const I4 k = axes.bins_of((b.lo + b.hi) * 0.5f);
+            for (int a = 0; a < 3; ++a) binned.add(a, k[a], b);
         }
-        std::array<Box3, 256> right_box;
+        std::array<LaneBox, 256> right_box;
         std::array<std::uint32_t, 256> right_count;
         for (int a = 0; a < 3; ++a) {
             if (!(cbox.hi[a] > cbox.lo[a])) continue;
-            Box3 acc;
+            LaneBox acc = LaneBox::empty();
             std::uint32_t n = 0;
             for (int k = bins - 1; k > 0; --k) {  // right side of a split before bin k
-                acc.extend(binned.box(a, k));
+                acc.extend(binned.box[a][k]);
                 n += binned.count[a][k];
                 right_box[k] = acc;
                 right_count[k] = n;
             }
-            acc = Box3{};
+            acc = LaneBox::empty();
             n = 0;
             for (int k = 1; k < bins; ++k) {
-                acc.extend(binned.box(a, k - 1));
+                acc.extend(binned.box[a][k - 1]);
                 n += binned.count[a][k - 1];
                 if (n == 0 || right_count[k] == 0) continue;
-                const double c = split_cost(acc, n, right_box[k], right_count[k], parent);
-                if (best.axis < 0 || c < best.cost) best = {a, k, c, false, 0.f, acc, right_box[k]};
+                const double c = split_cost(acc.area(), n, right_box[k].area(), right_count[k], parent);
+                if (best.axis < 0 || c < best.cost) best = {a, k, c, false, 0.f, acc.box(), right_box[k].box()};
             }
         }
         return best;
@@ -210,39 +223,39 @@ private:
         const LaneAxes axes(box, bins);
         LaneBoxBins entry(bins), exit(bins);
         for (const Ref& r : refs) {
-            const F4 lo = lanes_lo(r), hi = lanes_hi(r);
-            const I4 first = axes.bins_of(lo), to = axes.bins_of(hi);
+            const LaneBox b{lanes_lo(r), lanes_hi(r)};
+            const I4 first = axes.bins_of(b.lo), to = axes.bins_of(b.hi);
             const I4 last = to < first ? first : to;
             for (int a = 0; a < 3; ++a) {
-                entry.add(a, first[a], lo, hi);
-                exit.add(a, last[a], lo, hi);
+                entry.add(a, first[a], b);
+                exit.add(a, last[a], b);
             }
         }
-        std::array<Box3, 256> right_box;
+        std::array<LaneBox, 256> right_box;
         std::array<std::uint32_t, 256> right_count;
         for (int a = 0; a < 3; ++a) {
             if (!(box.hi[a] > box.lo[a])) continue;
             const float width = (box.hi[a] - box.lo[a]) / static_cast<float>(bins);
             const auto plane = [&](int k) { return box.lo[a] + width * static_cast<float>(k); };
-            Box3 acc;
+            LaneBox acc = LaneBox::empty();
             std::uint32_t n = 0;
             for (int k = bins - 1; k > 0; --k) {  // right of the plane before bin k
-                acc.extend(exit.box(a, k));
+                acc.extend(exit.box[a][k]);
                 n += exit.count[a][k];
                 right_box[k] = acc;
                 right_box[k].lo[a] = std::max(acc.lo[a], plane(k));
                 right_count[k] = n;
             }
-            acc = Box3{};
+            acc = LaneBox::empty();
             n = 0;
             for (int k = 1; k < bins; ++k) {
-                acc.extend(entry.box(a, k - 1));
+                acc.extend(entry.box[a][k - 1]);
                 n += entry.count[a][k - 1];
                 if (n == 0 || right_count[k] == 0) continue;
                 if (static_cast<double>(n + right_count[k] - refs.size()) > budget) continue;
-                Box3 left = acc;
+                LaneBox left = acc;
                 left.hi[a] = std::min(acc.hi[a], plane(k));
-                const double c = split_cost(left, n, right_box[k], right_count[k], parent);
+                const double c = split_cost(left.area(), n, right_box[k].area(), right_count[k], parent);
                 if (best.axis < 0 || c < best.cost) best = {a, k, c, true, plane(k), {}, {}};
             }
         }
