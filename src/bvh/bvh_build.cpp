@@ -308,11 +308,14 @@ private:
     // parallel build the children of a large node are built as two tasks, each into a piece of its
     // own, appended in order: the nodes and their indices are the sequential build's.
     std::uint32_t build(Piece& out, std::vector<Ref>&& refs, int depth, double budget) {
-        Box3 box, cbox;
+        LaneBox bounds = LaneBox::empty(), centres = LaneBox::empty();  // Box3::extend's bits, in lanes
         for (const Ref& r : refs) {
-            box.extend(r.box);
-            cbox.extend(r.box.center());
+            const LaneBox b{lanes_lo(r), lanes_hi(r)};
+            const F4 centre = (b.lo + b.hi) * 0.5f;
+            bounds.extend(b);
+            centres.extend({centre, centre});
         }
+        const Box3 box = bounds.box(), cbox = centres.box();
         const auto index = static_cast<std::uint32_t>(out.nodes.size());
         out.nodes.push_back({});
         out.nodes[index].box = box;
