@@ -137,6 +137,12 @@ TEST(Bvh, EveryTriangleInOneLeafAndEveryBoxExact) {
     }
 }
 
+// A linear congruential generator's numbers in [0, 1): 24 bits, so exact in float and double alike.
+struct Lcg {
+    std::uint32_t state;
+    float next() { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); }
+};
+
 // Long strips on a plane tilted against every axis, over small triangles scattered around it: the
 // strips' boxes overlap wherever objects split them, which is where spatial splits pay (Stich et al.
 // 2009, figure 1).
@@ -149,8 +155,8 @@ std::vector<Triangle> tilted_strips() {
         tris.push_back({lift(a), lift(b), lift(c)});
         tris.push_back({lift(c), lift(b), lift(d)});
     }
-    std::uint32_t state = 7;
-    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    Lcg rng{7};
+    const auto next = [&] { return rng.next(); };
     for (int i = 0; i < 1600; ++i) {
         const Vec3 p{next() * 10, next() * 10 - 5, next() * 5};
         tris.push_back({p, p + Vec3{0.1f, 0.f, 0.f}, p + Vec3{0.f, 0.1f, 0.05f}});
@@ -162,8 +168,8 @@ std::vector<Triangle> tilted_strips() {
 // region is crossed by most of its triangles, so a spatial split duplicates nearly all of them.
 std::vector<Triangle> crossing_slivers(int count) {
     std::vector<Triangle> tris;
-    std::uint32_t state = 7;
-    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    Lcg rng{7};
+    const auto next = [&] { return rng.next(); };
     for (int i = 0; i < count; ++i) {
         const Vec3 p{next() * 10, next() * 10, next() * 10}, q{next() * 10, next() * 10, next() * 10};
         const Vec3 w{next() * 0.05f, next() * 0.05f, next() * 0.05f};
@@ -211,8 +217,8 @@ TEST(Bvh, SpatialSplitsCoverEveryTriangleWithinTheBudget) {
 // at scales from 2^-100 to 2^100, planes through vertices and between them. It fails when the
 // crossings are rounded to the nearest float instead of outward (tried).
 TEST(Bvh, SplitReferenceBoxesHoldTheExactParts) {
-    std::uint32_t state = 5;
-    auto next = [&] { return static_cast<double>((state = state * 1664525u + 1013904223u) >> 8) / double(1 << 24); };
+    Lcg rng{5};
+    const auto next = [&] { return static_cast<double>(rng.next()); };
     using Exact = long double;
     int crossings = 0, tight = 0;
     for (int i = 0; i < 20000; ++i) {
@@ -273,8 +279,8 @@ TEST(Bvh, SplitReferenceBoxesHoldTheExactParts) {
 // dozen of them for a higher SAH cost.
 TEST(Bvh, NoSpatialSplitAmongTrianglesSmallAgainstEveryNode) {
     std::vector<Triangle> tris;
-    std::uint32_t state = 11;
-    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    Lcg rng{11};
+    const auto next = [&] { return rng.next(); };
     for (int i = 0; i < 20000; ++i) {
         const Vec3 p{next(), next(), next()};
         const auto jitter = [&] { return Vec3{next(), next(), next()} * 0.004f - Vec3(0.002f); };

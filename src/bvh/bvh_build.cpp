@@ -66,6 +66,7 @@ struct LaneBox {
         lo = b.lo < lo ? b.lo : lo;
         hi = hi < b.hi ? b.hi : hi;
     }
+    F4 centre() const { return (lo + hi) * 0.5f; }  // Box3::center's arithmetic
     Box3 box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
     double area() const {
         if (lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]) return 0.0;
@@ -180,7 +181,7 @@ private:
         LaneBoxBins binned(bins);
         for (const Ref& r : refs) {
             const LaneBox b{lanes_lo(r), lanes_hi(r)};
-            const I4 k = axes.bins_of((b.lo + b.hi) * 0.5f);
+            const I4 k = axes.bins_of(b.centre());
             for (int a = 0; a < 3; ++a) binned.add(a, k[a], b);
         }
         std::array<LaneBox, 256> right_box;
@@ -311,9 +312,8 @@ private:
         LaneBox bounds = LaneBox::empty(), centres = LaneBox::empty();  // Box3::extend's bits, in lanes
         for (const Ref& r : refs) {
             const LaneBox b{lanes_lo(r), lanes_hi(r)};
-            const F4 centre = (b.lo + b.hi) * 0.5f;
             bounds.extend(b);
-            centres.extend({centre, centre});
+            centres.extend({b.centre(), b.centre()});
         }
         const Box3 box = bounds.box(), cbox = centres.box();
         const auto index = static_cast<std::uint32_t>(out.nodes.size());

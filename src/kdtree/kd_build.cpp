@@ -750,26 +750,29 @@ private:
         x = swap ? b : a;
         y = swap ? a : b;
     }
-    // The network's compare-exchanges in order: runs of p, 2p, ... merged (Knuth's algorithm M).
-    template <std::size_t n>
-    static constexpr std::size_t network_size() {
-        std::size_t count = 0;
+    // The network's compare-exchanges in order, fn(first, second) for each: runs of p, 2p, ...
+    // merged (Knuth's algorithm M).
+    template <std::size_t n, class Fn>
+    static constexpr void network(Fn&& fn) {
         for (std::size_t p = 1; p < n; p += p)
             for (std::size_t k = p; k >= 1; k /= 2)
                 for (std::size_t j = k % p; j + k < n; j += 2 * k)
-                    for (std::size_t i = 0; i < k && i + j + k < n; ++i) count += (i + j) / (2 * p) == (i + j + k) / (2 * p);
+                    for (std::size_t i = 0; i < k && i + j + k < n; ++i)
+                        if ((i + j) / (2 * p) == (i + j + k) / (2 * p)) fn(i + j, i + j + k);
+    }
+    template <std::size_t n>
+    static constexpr std::size_t network_size() {
+        std::size_t count = 0;
+        network<n>([&](std::size_t, std::size_t) { ++count; });
         return count;
     }
     template <std::size_t n>
     static constexpr auto network_pairs() {
         std::array<std::pair<std::uint8_t, std::uint8_t>, network_size<n>()> out{};
         std::size_t count = 0;
-        for (std::size_t p = 1; p < n; p += p)
-            for (std::size_t k = p; k >= 1; k /= 2)
-                for (std::size_t j = k % p; j + k < n; j += 2 * k)
-                    for (std::size_t i = 0; i < k && i + j + k < n; ++i)
-                        if ((i + j) / (2 * p) == (i + j + k) / (2 * p))
-                            out[count++] = {static_cast<std::uint8_t>(i + j), static_cast<std::uint8_t>(i + j + k)};
+        network<n>([&](std::size_t a, std::size_t b) {
+            out[count++] = {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
+        });
         return out;
     }
 

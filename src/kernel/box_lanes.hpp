@@ -5,6 +5,7 @@
 #pragma once
 
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 
@@ -16,7 +17,7 @@ typedef float F4 __attribute__((vector_size(16)));
 typedef std::int32_t I4 __attribute__((vector_size(16)));
 
 template <class Record>
-constexpr bool kBoxFirst = sizeof(Record) >= sizeof(Box3) + 4 && sizeof(Box3) == 24;
+constexpr bool kBoxFirst = offsetof(Record, box) == 0 && sizeof(Record) >= sizeof(Box3) + 4 && sizeof(Box3) == 24;
 
 // The record's box corners, one unaligned load each; the lane past z is the next field (hi.x for
 // `lo`; for `hi`, the record's next four bytes, zeroed: their bits could be a denormal, slow to add).
