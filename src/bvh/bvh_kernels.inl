@@ -48,11 +48,11 @@ struct BoxRay {
     }
 };
 
-// A node's children met by the ray within [tnear - margin, cull], as a bit mask, with each one's
+// A node's children met by the ray within [tnear - margin, cull], as a lane mask, with each one's
 // entry distance. The scalar clip() widens every plane distance by the margin before it takes the
 // extremes; here the extremes are widened once: rounding is monotonic, so max(a - m, b - m) is
 // max(a, b) - m bit for bit, and the NaN-keeping max and min skip the same planes either way.
-inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
+inline I meet_children_lanes(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
     static_assert(offsetof(BvhNode, hi) == 3 * kBvhWidth * sizeof(float), "hi follows lo");
     const float* planes = &node.lo[0][0];
     F enter = splat(r.tnear), leave = splat(kInfinity);
@@ -62,7 +62,11 @@ inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, 
     }
     const F margin = splat(r.margin);
     entry = enter - margin;
-    return bits(entry <= min_keep(splat(cull), leave + margin));
+    return entry <= min_keep(splat(cull), leave + margin);
+}
+// The same as a bit mask.
+inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
+    return bits(meet_children_lanes(node, r, cull, entry));
 }
 
 // The watertight test's per-ray constants (triangle.hpp's WatertightRay) in all lanes, made once per
@@ -121,15 +125,32 @@ inline I met_mask(unsigned met) {
     return (splat_i(static_cast<std::int32_t>(met)) & I{1, 2, 4, 8, 16, 32, 64, 128}) != 0;
 }
 
-// The smallest of eight lanes.
-inline float horizontal_min(F x) {
-    F y = __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3);
-    x = select(y < x, y, x);
-    y = __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5);
-    x = select(y < x, y, x);
-    y = __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6);
-    x = select(y < x, y, x);
+// The smallest of eight lanes, floats or integers (by `min`).
+template <class V, class Min>
+inline auto horizontal_min(V x, Min min) {
+    x = min(x, __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3));
+    x = min(x, __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5));
+    x = min(x, __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6));
     return x[0];
+}
+inline float horizontal_min(F x) {
+    return horizontal_min(x, [](F a, F b) { return select(b < a, b, a); });
+}
+
+// The lane of `met` with the smallest entry distance: one integer minimum over keys that carry a
+// lane's distance in their high bits and its index in the low three, so that the index comes out
+// of the minimum itself. The float-then-compare-then-mask it replaces sat on the path to the next
+// node's address, about twice as long (docs/INCOHERENT.md, "Tenth round"). A float's bits, with
+// the magnitude bits of negatives flipped, order as signed integers as the floats do; dropping the
+// low three mantissa bits may swap two children whose distances differ by less than 8 ulp, which
+// changes only the order of the visit, never its answer (every child met is visited or culled by
+// its exact entry distance). `met` is the box test's lane mask, not its bits, so that the minimum
+// need not wait for the bits to come back from a general register as a mask.
+inline unsigned nearest_lane(F entry, I met) {
+    const I b = reinterpret_cast<I>(entry);
+    const I ordered = b ^ ((b >> 31) & 0x7fffffff);
+    const I key = (ordered & ~7) | I{0, 1, 2, 3, 4, 5, 6, 7};
+    return static_cast<unsigned>(horizontal_min(select(met, key, splat_i(INT32_MAX)), min_i)) & 7u;
 }
 
 // Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
@@ -228,7 +249,8 @@ bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay
             c.node();
             const BvhNode& node = nodes[word];
             F entry;
-            const unsigned met = meet_children(node, box_ray, q.cull_t(), entry);
+            const I met_lanes = meet_children_lanes(node, box_ray, q.cull_t(), entry);
+            const unsigned met = bits(met_lanes);
             if (met) {
                 // One child met (the common case deep in the tree): go there. Several: the nearest
                 // goes first, the others wait unsorted (sorting them costs more on incoherent rays
@@ -242,10 +264,7 @@ bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay
                     continue;
                 }
                 unsigned next = __builtin_ctz(met);
-                if constexpr (!Query::kAnyHit) {
-                    const F masked = select(met_mask(met), entry, splat(kInfinity));
-                    next = __builtin_ctz(bits(masked == splat(horizontal_min(masked))) & met);
-                }
+                if constexpr (!Query::kAnyHit) next = nearest_lane(entry, met_lanes);
                 word = node.child[next];
                 push_children(node, met & ~(1u << next), entry, word_stack, kCulls ? entry_stack : nullptr, size);
                 continue;

@@ -78,6 +78,23 @@ inline F select(I m, F a, F b) { return m ? a : b; }
 inline I select(I m, I a, I b) { return m ? a : b; }
 inline U select(I m, U a, U b) { return m ? a : b; }
 
+// The smaller of two integers, lane by lane: one instruction where the set has one (GCC 12 makes a
+// compare and a masked move of the generic a < b ? a : b). By the vector's size, as lane_bits.
+template <class V>
+inline V lane_min_i(V a, V b) {
+#if defined(CELLRT_SIMD_AVX512)
+    if constexpr (sizeof(V) == 64) return reinterpret_cast<V>(_mm512_min_epi32(reinterpret_cast<__m512i>(a), reinterpret_cast<__m512i>(b)));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2)
+    if constexpr (sizeof(V) == 32) return reinterpret_cast<V>(_mm256_min_epi32(reinterpret_cast<__m256i>(a), reinterpret_cast<__m256i>(b)));
+#endif
+#if defined(CELLRT_SIMD_AVX512) || defined(CELLRT_SIMD_AVX2) || defined(CELLRT_SIMD_SSE)
+    if constexpr (sizeof(V) == 16) return reinterpret_cast<V>(_mm_min_epi32(reinterpret_cast<__m128i>(a), reinterpret_cast<__m128i>(b)));
+#endif
+    return b < a ? b : a;
+}
+inline I min_i(I a, I b) { return lane_min_i(a, b); }
+
 // The scalar kernels' NaN-keeping min/max (kernel/traversal.hpp), lane by lane.
 inline F min_keep(F kept, F x) { return select(x < kept, x, kept); }
 inline F max_keep(F kept, F x) { return select(x > kept, x, kept); }
