@@ -15,6 +15,7 @@
 #include "bvh/bvh_accel.hpp"
 #include "bvh/bvh_build.hpp"
 #include "bvh/split_reference.hpp"
+#include "simd/isa.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/workload.hpp"
 #include "cellrt/error.hpp"
@@ -424,6 +425,51 @@ TEST(Bvh, StreamViewSharesTheTree) {
     EXPECT_EQ(view->stats().tree->nodes, single->stats().tree->nodes);
     EXPECT_THROW(detail::bvh_with_traversal(*make_accelerator(scene.triangles, AccelConfig{"kd"}), "stream"), Error);
     EXPECT_THROW(detail::bvh_with_traversal(*single, "branched"), Error);
+}
+
+// A closest-hit ray that meets several children goes to the nearest first (nearest_lane), so that
+// its first hit culls the rest. Eight walls across the x axis, one leaf each, all children of the
+// root; rays along +x and along -x (one of the two meets the lanes in the reverse of their order,
+// whatever order the builder gave them) each test one leaf, in every instruction set's kernel. The
+// answers would be exact in any order; this holds the order, which only the counters show (a
+// kernel that took the first lane met tests up to all eight leaves).
+TEST(Bvh, ClosestHitVisitsTheNearestChildFirst) {
+    constexpr int kWalls = 8;
+    std::vector<Triangle> walls;
+    for (int i = 1; i <= kWalls; ++i) {
+        const auto x = static_cast<float>(i);
+        walls.push_back({{x, -1.f, -1.f}, {x, 1.f, -1.f}, {x, 1.f, 1.f}});
+        walls.push_back({{x, -1.f, -1.f}, {x, 1.f, 1.f}, {x, -1.f, 1.f}});
+    }
+    BvhBuildOptions options;
+    options.max_leaf = 2;
+    const BvhTree tree = detail::build_bvh(walls, options);
+    ASSERT_EQ(tree.nodes.size(), 1u) << "the root alone, its children the walls' leaves";
+    for (std::uint32_t word : tree.nodes[0].child) ASSERT_TRUE(BvhNode::is_leaf(word));
+    std::vector<Ray> rays;
+    for (float y = -0.85f; y < 0.9f; y += 0.25f)
+        for (float z = -0.8f; z < 0.9f; z += 0.3f)
+            for (float side : {0.f, kWalls + 1.f}) {
+                Ray r;
+                r.org = {side, y, z};
+                r.dir = {side == 0.f ? 1.f : -1.f, 0.f, 0.f};
+                rays.push_back(r);
+            }
+    const test::ReferenceAnswers ref = test::compute_reference(walls, rays);
+    for (detail::Isa isa : detail::available_isas()) {
+        const std::string config = std::string("bvh+") + detail::to_string(isa) + "@max_leaf=2";
+        const auto accel = make_accelerator(walls, parse_accel_config(config));
+        std::vector<Hit> hits(rays.size());
+        TraversalCounters counters;
+        accel->intersect(rays, hits, &counters);
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            ASSERT_EQ(hits[i], ref.hits[i]) << config << ", ray " << i;
+            EXPECT_EQ(hits[i].t, 1.f) << config << ", ray " << i;
+            EXPECT_EQ(hits[i].prim / 2, rays[i].dir[0] > 0.f ? 0u : kWalls - 1u) << config << ", ray " << i;
+        }
+        EXPECT_EQ(counters.nodes, rays.size()) << config;
+        EXPECT_EQ(counters.leaves, rays.size()) << config << ": a leaf past the nearest was tested";
+    }
 }
 
 TEST(Bvh, EmptySceneMissesEverything) {
