@@ -1,0 +1,25 @@
+#!/usr/bin/env python3
+"""Issue 18's figures from run.sh's files: per ray kind and scene, each config's time (primary +
+shadow seconds) over Embree's fastest (the lesser of embree:single and embree:packet8) in the same
+run, as speed ratios (Embree's time / config's time); the median of the runs, and their range."""
+import json, glob, statistics, sys
+kinds = ['frame', 'ao', 'diffuse', 'random']
+configs = ['auto', 'bvh', 'bvh:packet', 'kd:rec', 'kd:branched']
+print('| rays | scene | ' + ' | '.join(f'`{c}`' for c in configs) + ' | kd:rec primary ÷ rtcIntersect1 |')
+print('|---|---|' + '--:|' * (len(configs) + 1))
+for kind in kinds:
+    runs = [json.load(open(f)) for f in sorted(glob.glob(f'state_{kind}_*.json'))]
+    scenes = []
+    for r in runs[0]:
+        if r['scene'] not in scenes: scenes.append(r['scene'])
+    for sc in scenes:
+        cells = {c: [] for c in configs}
+        single = []
+        for run in runs:
+            d = {r['config']: r for r in run if r['scene'] == sc}
+            t = lambda c: d[c]['primary_seconds'] + d[c]['shadow_seconds']
+            emb = min(t('embree:single'), t('embree:packet8'))
+            for c in configs: cells[c].append(emb / t(c))
+            single.append(d['embree:single']['primary_seconds'] / d['kd:rec']['primary_seconds'])
+        fmt = lambda v: f'{statistics.median(v):.2f} ({min(v):.2f}–{max(v):.2f})'
+        print(f'| {kind} | {sc} | ' + ' | '.join(fmt(cells[c]) for c in configs) + f' | {fmt(single)} |')
