@@ -4,8 +4,8 @@
 
 // Eight-float vectors passed by value without AVX: GCC notes that their ABI differs from an AVX
 // build's. These functions are internal to this unit (inline, in its own namespace), so no call
-// crosses that boundary.
-#pragma GCC diagnostic ignored "-Wpsabi"
+// crosses that boundary; CMakeLists.txt compiles the unit with -Wno-psabi (a pragma here misses the
+// notes GCC emits without a source location).
 
 namespace cellrt::detail::isa_portable {
 constexpr int kLanes = 4;

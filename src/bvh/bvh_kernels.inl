@@ -125,16 +125,13 @@ inline I met_mask(unsigned met) {
     return (splat_i(static_cast<std::int32_t>(met)) & I{1, 2, 4, 8, 16, 32, 64, 128}) != 0;
 }
 
-// The smallest of eight lanes, floats or integers (by `min`).
-template <class V, class Min>
-inline auto horizontal_min(V x, Min min) {
-    x = min(x, __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3));
-    x = min(x, __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5));
-    x = min(x, __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6));
+// The smallest of eight lanes, floats or integers.
+template <class V>
+inline auto horizontal_min(V x) {
+    x = min_lanes(x, __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3));
+    x = min_lanes(x, __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5));
+    x = min_lanes(x, __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6));
     return x[0];
-}
-inline float horizontal_min(F x) {
-    return horizontal_min(x, [](F a, F b) { return select(b < a, b, a); });
 }
 
 // The lane of `met` with the smallest entry distance: one integer minimum over keys that carry a
@@ -150,7 +147,7 @@ inline unsigned nearest_lane(F entry, I met) {
     const I b = reinterpret_cast<I>(entry);
     const I ordered = b ^ ((b >> 31) & 0x7fffffff);
     const I key = (ordered & ~7) | I{0, 1, 2, 3, 4, 5, 6, 7};
-    return static_cast<unsigned>(horizontal_min(select(met, key, splat_i(INT32_MAX)), min_i)) & 7u;
+    return static_cast<unsigned>(horizontal_min(select(met, key, splat_i(INT32_MAX)))) & 7u;
 }
 
 // Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.

@@ -93,8 +93,11 @@ inline V lane_min_i(V a, V b) {
 #endif
     return b < a ? b : a;
 }
-inline I min_i(I a, I b) { return lane_min_i(a, b); }
 
 // The scalar kernels' NaN-keeping min/max (kernel/traversal.hpp), lane by lane.
 inline F min_keep(F kept, F x) { return select(x < kept, x, kept); }
 inline F max_keep(F kept, F x) { return select(x > kept, x, kept); }
+
+// The lane-wise minimum by type, for code written once for floats and integers.
+inline F min_lanes(F a, F b) { return min_keep(a, b); }
+inline I min_lanes(I a, I b) { return lane_min_i(a, b); }
