@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <new>
@@ -40,20 +41,24 @@ constexpr int kTagAbort = 7;
 }  // namespace
 
 void Session::wait(MPI_Request& request, const std::string& what) const {
-    const double limit = static_cast<double>(timeout_.count()) / 1e3 * (leader() ? 1.0 : 2.0);
     Timer timer;
     int done = 0;
     for (MPI_Test(&request, &done, MPI_STATUS_IGNORE); !done; MPI_Test(&request, &done, MPI_STATUS_IGNORE)) {
-        if (!leader()) {
-            int aborting = 0;
-            MPI_Iprobe(0, kTagAbort, MPI_COMM_WORLD, &aborting, MPI_STATUS_IGNORE);
-            if (aborting) std::_Exit(1);  // rank 0 has printed the cause and is ending the job
-        }
-        if (timer.seconds() > limit)
-            abort("no answer to " + what + " within " + (leader() ? "" : "twice ") + timeout_text() +
-                  " (a rank stopped answering; --rank-timeout)");
+        poll_ending(timer.seconds(), what);
         std::this_thread::sleep_for(kPollInterval);
     }
+}
+
+void Session::poll_ending(double waited, const std::string& what) const {
+    if (!leader()) {
+        int aborting = 0;
+        MPI_Iprobe(0, kTagAbort, MPI_COMM_WORLD, &aborting, MPI_STATUS_IGNORE);
+        if (aborting) std::_Exit(1);  // rank 0 has printed the cause and is ending the job
+    }
+    const double limit = static_cast<double>(timeout_.count()) / 1e3 * (leader() ? 1.0 : 2.0);
+    if (waited > limit)
+        abort("no answer to " + what + " within " + (leader() ? "" : "twice ") + timeout_text() +
+              " (a rank stopped answering; --rank-timeout)");
 }
 
 void Session::abort(const std::string& message) const {

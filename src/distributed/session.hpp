@@ -58,6 +58,11 @@ public:
     // stopped answering cannot take part in an orderly end).
     void wait(MPI_Request& request, const std::string& what) const;
 
+    // One poll of wait() for a caller that runs its own loop: on ranks other than 0, ends this process
+    // (status 1, without a message) once rank 0 has said that the job is ending; aborts as wait() does
+    // once `waited` seconds exceed its time-out.
+    void poll_ending(double waited, const std::string& what) const;
+
     // Prints "PROGRAM: error: rank R: MESSAGE" and ends the whole job with status 1. Rank 0 first tells
     // the others, which then end at their next wait without a message of their own.
     [[noreturn]] void abort(const std::string& message) const;

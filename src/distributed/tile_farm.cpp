@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -21,6 +24,13 @@ namespace {
 
 constexpr int kTagAssign = 1, kTagResult = 2;
 constexpr std::int32_t kNoTile = -1;
+
+// How often a rank's MPI thread polls while its tracer works: often enough to move a tile's fragments
+// on as they are asked for, against a tile's milliseconds.
+constexpr std::chrono::microseconds kWorkerPoll{100};
+// Its wait while nothing is in flight and tiles are queued: long against a tile, short against a
+// time-out, so that it still hears rank 0 end the job.
+constexpr std::chrono::milliseconds kIdlePoll{5};
 
 // A returned tile: its pixels (traced), the cause (failed), or nothing (skipped: the rank had failed
 // before it reached the tile).
@@ -93,11 +103,16 @@ public:
         sends_.push_back({std::move(bytes), MPI_REQUEST_NULL});
         Send& s = sends_.back();
         MPI_Isend(s.bytes.data(), static_cast<int>(s.bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &s.request);
+        progress();
+    }
+    // Lets MPI move the sends on and forgets those it is done with.
+    void progress() {
         for (int done = 1; done && !sends_.empty(); sends_.pop_front()) {
             MPI_Test(&sends_.front().request, &done, MPI_STATUS_IGNORE);
             if (!done) break;
         }
     }
+    bool empty() const { return sends_.empty(); }
     void flush(const Session& session, const std::string& what) {
         for (; !sends_.empty(); sends_.pop_front()) session.wait(sends_.front().request, what);
     }
@@ -136,8 +151,13 @@ std::unique_ptr<FrameRenderer> start_renderer(const Scene& scene, const Accelera
     }
 }
 
-// A rank other than 0: traces the tiles rank 0 hands it and returns each; a tile arrives for each
-// tile returned and `ahead` at the start, until rank 0 answers that none is left.
+// A rank other than 0: traces the tiles rank 0 hands it and returns each one's pixels; one more
+// answer is owed for every tile returned and `ahead` at the start, until rank 0 answers that none is
+// left. A thread of its own traces while this one, the only one that calls MPI, polls: a tile's
+// pixels exceed the eager limit of MPI's shared-memory and network transports, so they travel in
+// fragments that move only while the sender calls MPI. A rank that called MPI only between tiles
+// sent each tile's last fragments a tile or more late and waited for its next tile (with Open MPI
+// and no single-copy transport, 16 ranks on one machine: busy 40 % of the frame; docs/DISTRIBUTED.md).
 RankLoad trace_for_master(const Session& session, const Scene& scene, const Accelerator& accel,
                           const RenderOptions& options, const TileGrid& grid, int ahead,
                           std::optional<std::string>& failure) {
@@ -146,59 +166,101 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     load.threads = o.threads;
     Timer frame_timer;
     const double cpu_start = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+
+    // Between the threads: tiles to trace, traced tiles' messages, and the word that no tile is left.
+    std::mutex mutex;
+    std::condition_variable assigned, returned;
     std::deque<std::int32_t> queue;
-    int pending = ahead;  // answers rank 0 still owes this rank
+    std::deque<std::string> traced;
+    bool no_more = false;
+    std::thread tracer([&] {
+        Image tile;
+        const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
+        for (bool first = true;; first = false) {
+            std::int32_t t = kNoTile;
+            {
+                std::unique_lock lock(mutex);
+                assigned.wait(lock, [&] { return !queue.empty() || no_more; });
+                if (queue.empty()) return;
+                t = queue.front();
+                queue.pop_front();
+                if (queue.empty()) returned.notify_one();  // time to look for the next tiles
+            }
+            if (first) inject_fault(session.rank());
+            std::string bytes(sizeof(ResultHeader), '\0');
+            ResultHeader header{t, Outcome::skipped, 0.0};
+            if (!failure) {
+                try {
+                    RenderStats s;
+                    renderer->render_window(grid.rect(static_cast<std::size_t>(t)), tile, &s);
+                    add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
+                    header.outcome = Outcome::traced;
+                    header.seconds = s.seconds;
+                    bytes.append(reinterpret_cast<const char*>(tile.pixels.data()),
+                                 tile.pixels.size() * sizeof(Vec3));
+                } catch (const std::exception& e) {
+                    failure = e.what();
+                    header.outcome = Outcome::failed;
+                    bytes.append(failure->substr(0, kMaxCause));
+                }
+            }
+            std::memcpy(bytes.data(), &header, sizeof header);
+            const std::lock_guard lock(mutex);
+            traced.push_back(std::move(bytes));
+            returned.notify_one();
+        }
+    });
+
+    int pending = ahead;     // answers rank 0 still owes this rank
+    std::size_t held = 0;    // tiles received and not yet returned
     std::int32_t incoming = kNoTile;
     MPI_Request answer = MPI_REQUEST_NULL;
     bool posted = false;
-    // Takes the answers that have come (with `wait`, waits for one first).
-    auto take = [&](bool wait) {
+    Outbox outbox;
+    Timer waiting;  // since this rank last had a tile in hand
+    for (;;) {
+        std::deque<std::string> ready;
+        {
+            const std::lock_guard lock(mutex);
+            ready.swap(traced);
+        }
+        for (std::string& bytes : ready) {
+            outbox.send(std::move(bytes), 0, kTagResult);
+            ++pending;
+            --held;
+        }
+        outbox.progress();
         while (pending > 0) {
             if (!posted) MPI_Irecv(&incoming, 1, MPI_INT32_T, 0, kTagAssign, MPI_COMM_WORLD, &answer);
             posted = true;
-            int done = 1;
-            if (wait)
-                session.wait(answer, "rank 0's next tile");
-            else
-                MPI_Test(&answer, &done, MPI_STATUS_IGNORE);
-            if (!done) return;
-            wait = false;
+            int done = 0;
+            MPI_Test(&answer, &done, MPI_STATUS_IGNORE);
+            if (!done) break;
             posted = false;
             --pending;
-            if (incoming != kNoTile) queue.push_back(incoming);
+            if (incoming == kNoTile) continue;
+            ++held;
+            const std::lock_guard lock(mutex);
+            queue.push_back(incoming);
+            assigned.notify_one();
         }
-    };
-    Outbox outbox;
-    Image tile;
-    const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
-    bool first = true;
-    while (!queue.empty() || pending > 0) {
-        take(queue.empty());
-        if (queue.empty()) continue;
-        if (first) inject_fault(session.rank());
-        first = false;
-        const std::int32_t t = queue.front();
-        queue.pop_front();
-        std::string bytes(sizeof(ResultHeader), '\0');
-        ResultHeader header{t, Outcome::skipped, 0.0};
-        if (!failure) {
-            try {
-                RenderStats s;
-                renderer->render_window(grid.rect(static_cast<std::size_t>(t)), tile, &s);
-                add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
-                header.outcome = Outcome::traced;
-                header.seconds = s.seconds;
-                bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
-            } catch (const std::exception& e) {
-                failure = e.what();
-                header.outcome = Outcome::failed;
-                bytes.append(failure->substr(0, kMaxCause));
-            }
-        }
-        std::memcpy(bytes.data(), &header, sizeof header);
-        outbox.send(std::move(bytes), 0, kTagResult);
-        ++pending;
+        if (pending == 0 && held == 0) break;
+        if (held > 0) waiting = Timer();
+        session.poll_ending(waiting.seconds(), "rank 0's next tile");
+        // Quick polls while pixels travel or the tracer has nothing queued; else little to do here
+        // until a tile is traced or the queue empties (answers wait in MPI's queue meanwhile).
+        std::unique_lock lock(mutex);
+        if (outbox.empty() && !queue.empty())
+            returned.wait_for(lock, kIdlePoll, [&] { return !traced.empty() || queue.empty(); });
+        else
+            returned.wait_for(lock, kWorkerPoll, [&] { return !traced.empty(); });
     }
+    {
+        const std::lock_guard lock(mutex);
+        no_more = true;
+    }
+    assigned.notify_one();
+    tracer.join();
     outbox.flush(session, "rank 0's receipt of the last tiles");
     load.seconds = frame_timer.seconds();
     load.cpu_seconds = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
@@ -254,13 +316,17 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     std::vector<double> heard(ranks, 0.0), tile_time(ranks, 0.0);  // last result; a tile's mean time
     // The master polls often enough to answer a rank before its queued tiles run out, and no more
     // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md). The ranks' own tracing
-    // times set it, not the gaps between their results, which grow when a rank waits.
+    // times set it, not the gaps between their results, which grow when a rank waits. A tile's pixels
+    // take several polls on each side where they travel in fragments (a transport without single
+    // copies moves a few fragments a poll): 8 polls in the time of the tiles a rank has queued
+    // (with 4, such a transport left 2 ranks waiting as before; with 16, rank 0's polls cost 3 %
+    // more with a single-copy transport; docs/DISTRIBUTED.md).
     auto poll_interval = [&] {
         double fastest = 0.0;
         for (std::size_t r = 1; r < ranks; ++r)
             if (tile_time[r] > 0.0 && (fastest == 0.0 || tile_time[r] < fastest)) fastest = tile_time[r];
         if (fastest == 0.0) return kPollInterval;
-        const double seconds = std::clamp(fastest * (ahead - 1) / 4.0, 100e-6, 2e-3);
+        const double seconds = std::clamp(fastest * (ahead - 1) / 8.0, 100e-6, 2e-3);
         return std::chrono::microseconds(static_cast<long long>(seconds * 1e6));
     };
     std::size_t max_tile_pixels = 0;
