@@ -4,21 +4,27 @@
 #   tools/device-check.sh prepare DIR   # here: build with CUDA and the benchmarks, pack the programs, their
 #                                       # libraries and the shared scenes into DIR (git-ignored), compressed:
 #                                       # about 26 MB (43 MB from a build with MPI) against the 64 MiB carry limit
-#   tools/device-check.sh run DIR       # there, in one go (about 8 minutes at most): results under $OUT
+#   tools/device-check.sh run DIR       # there, in one go (at most CELLRT_DEVICE_SECONDS, 550 s): results under $OUT
+#   tools/device-check.sh run DIR STEP...  # only these steps (gpu_tests gpu_bench cache_study scaling builds
+#                                       # mpi16 cache_study_async; build_curve, gpu_bench_packets,
+#                                       # gpu_bih_sweep and mpi16_sweep run only when named)
 #
-# `run` writes $OUT/info.txt (`cellrt info --device cuda`), $OUT/gpu_tests.json (the GPU tests, GoogleTest's
-# JSON), $OUT/gpu_bench.json and .md (the GPU benchmark beside Embree on all host cores, same rays),
-# $OUT/cache_study/ (the study's cache sweeps in the GPU's shared memory, memory mode (b), synchronous),
-# $OUT/scaling_pull_16core.json (the CPU scaling curve, docs/SCALING.md) and $OUT/cache_study_async/ (the
-# node cache's sweep with asynchronous access), each step under a time limit
-# of its own, and $OUT/summary.json with each step's exit status and seconds.
-# With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=560).
+# `run` writes $OUT/results.tar.gz and $OUT/summary.json (each step's exit status, seconds and limit);
+# the device tool returns eight files at most, so the archive holds the rest: info.log (`cellrt info
+# --device cuda`), gpu_tests.json (the GPU tests, GoogleTest's JSON), gpu_bench.json and .log (the GPU
+# benchmark beside Embree on all host cores, same rays), cache_study/ (the study's cache sweeps in the
+# GPU's shared memory, memory mode (b), synchronous), scaling_pull_16core.json (the CPU scaling curve,
+# docs/SCALING.md), builds_t1/t16 and builds_forest_t1/t16.json (docs/BUILD_SPEED.md), mpi/ (16 ranks
+# against one process, docs/DISTRIBUTED.md) and cache_study_async/ (the node cache's sweep with
+# asynchronous access). Each step runs under a time limit of its own and the run's deadline.
+# With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=600).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-usage() { echo "usage: tools/device-check.sh prepare DIR | run DIR" >&2; exit 2; }
-[[ $# -eq 2 ]] || usage
+usage() { echo "usage: tools/device-check.sh prepare DIR | run DIR [STEP...]" >&2; exit 2; }
+[[ $# -ge 2 ]] || usage
 step="$1"
 dir="$2"
+steps="${*:3}"
 
 case "$step" in
 prepare)
@@ -28,7 +34,10 @@ prepare)
   command -v nvcc >/dev/null || [[ -x /usr/local/cuda/bin/nvcc ]] ||
     { echo "tools/device-check.sh: nvcc not found: the CUDA backend cannot be built here" >&2; exit 1; }
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELLRT_CUDA=ON -DCELLRT_BENCH=ON
-  cmake --build "$build" -j "${CELLRT_JOBS:-2}" --target cellrt_cli cellrt_tests cellrt_bench cellrt_scaling cellrt_gpu_bench
+  targets=(cellrt_cli cellrt_tests cellrt_bench cellrt_scaling cellrt_gpu_bench)
+  # cellrt-mpi where CMake found MPI (the bundle then carries mpirun too).
+  if cmake --build "$build" --target help | grep -qw cellrt_mpi; then targets+=(cellrt_mpi); fi
+  cmake --build "$build" -j "${CELLRT_JOBS:-2}" --target "${targets[@]}"
   stage="$(mktemp -d)"
   trap 'rm -rf "$stage"' EXIT
   CELLRT_BUILD="$build" "$root/tools/bundle.sh" "$stage/bundle" "$build/tests/cellrt_tests" "$build/bench/cellrt_gpu_bench"
@@ -47,40 +56,145 @@ run)
   trap 'rm -rf "$dir"' EXIT
   tar -C "$dir" -xzf "$packed"
   run="$dir/bundle/run"
-  export CELLRT_SCENES="$dir/scenes" CELLRT_CLI="$dir/bundle/cellrt-cli" CELLRT_TEST_CACHE="$out/.reference_cache"
+  res="$dir/results"
+  mkdir -p "$res/mpi" "$res/mpi_sweep" "$dir/frames"
+  lscpu > "$res/lscpu.txt" 2>&1 || true
+  export CELLRT_SCENES="$dir/scenes" CELLRT_CLI="$dir/bundle/cellrt-cli" CELLRT_TEST_CACHE="$dir/reference_cache"
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
   # The tests start the program by one path: a wrapper with the bundle's libraries.
   printf '#!/usr/bin/env bash\nexec "%s" cellrt "$@"\n' "$run" > "$CELLRT_CLI"
   chmod +x "$CELLRT_CLI"
-  summary="$out/summary.json"
+  # The device tool returns at most eight files: every result goes into one archive, packed again
+  # after each step (and renamed into place), so that a call cut short still returns what was done.
+  # Each step stops at its own limit or at the run's deadline, whichever comes first.
+  deadline=$((SECONDS + ${CELLRT_DEVICE_SECONDS:-550}))
+  summary="$res/summary.json"
   echo "{" > "$summary"
-  timed() {  # NAME LIMIT_S COMMAND...: runs it under its limit, logs to $OUT/NAME.log, notes status and time
+  timed() {  # NAME LIMIT_S COMMAND...: runs it under its limit, logs to NAME.log, notes status and time
     local name="$1" limit="$2"; shift 2
-    local start=$SECONDS status=0
-    timeout "$limit" "$@" > "$out/$name.log" 2>&1 || status=$?
-    echo "  \"$name\": {\"status\": $status, \"seconds\": $((SECONDS - start))}," >> "$summary"
-    echo "$name: status $status, $((SECONDS - start)) s"
+    local left=$((deadline - SECONDS)) start=$SECONDS status=0
+    if ((left < limit)); then limit=$left; fi
+    if ((limit < 5)); then
+      echo "  \"$name\": {\"status\": \"skipped: the run's deadline\"}," >> "$summary"
+      echo "$name: skipped (the run's deadline)"
+      return
+    fi
+    timeout "$limit" "$@" > "$res/$name.log" 2>&1 || status=$?
+    echo "  \"$name\": {\"status\": $status, \"seconds\": $((SECONDS - start)), \"limit\": $limit}," >> "$summary"
+    echo "$name: status $status, $((SECONDS - start)) s (limit $limit s)"
+    tar -C "$dir" -czf "$out/.results.tar.gz" results && mv "$out/.results.tar.gz" "$out/results.tar.gz"
+    cp "$summary" "$out/summary.json"
   }
-  timed info 30 "$run" cellrt info --device cuda
-  cp "$out/info.log" "$out/info.txt"
-  if ! grep -q '^cuda ' "$out/info.txt"; then
-    echo "no CUDA device: $(cat "$out/info.txt")"
+  timed info 20 "$run" cellrt info --device cuda
+  if ! grep -q '^cuda ' "$res/info.log"; then
+    echo "no CUDA device: $(cat "$res/info.log")"
     echo "  \"device\": false }" >> "$summary"
+    cp "$summary" "$out/summary.json"
     exit 3
   fi
-  timed gpu_tests 150 "$run" cellrt_tests --gtest_filter='*Cuda*' --gtest_output="json:$out/gpu_tests.json"
-  timed gpu_bench 240 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza sibenik bunny builtin:city \
-    --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$out/gpu_bench.json"
-  cp "$out/gpu_bench.log" "$out/gpu_bench.md"
-  timed cache_study 75 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda --size 1920x1080 \
-    --sample 4 --structures kd bih --traversals branched --access sync -o "$out/cache_study"
-  timed scaling 100 "$run" cellrt_scaling --scenes-dir "$CELLRT_SCENES" --dispatch pull --packets 16 --repeats 3 \
-    --workers 1 2 4 8 12 16 --configs embree:single kd+auto bih+auto --json "$out/scaling_pull_16core.json"
+  wanted() { [[ -z "$steps" || " $steps " == *" $1 "* ]]; }
+  wanted gpu_tests && timed gpu_tests 120 "$run" cellrt_tests --gtest_filter='*Cuda*' --gtest_output="json:$res/gpu_tests.json"
+  wanted gpu_bench && timed gpu_bench 170 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
+    --scenes sponza sibenik bunny builtin:city --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$res/gpu_bench.json"
+  wanted cache_study && timed cache_study 50 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda \
+    --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access sync -o "$res/cache_study"
+  wanted scaling && timed scaling 60 "$run" cellrt_scaling --scenes-dir "$CELLRT_SCENES" --dispatch pull --packets 16 \
+    --repeats 3 --workers 1 2 4 8 16 --configs embree:single kd+auto bih+auto --json "$res/scaling_pull_16core.json"
+  # Embree's packets as the yardstick (gpu_bench's default is rtcIntersect1), against the fastest
+  # configuration of each tree in memory mode (a) (not by default).
+  if [[ " $steps " == *" gpu_bench_packets "* ]]; then
+    for w in 8 16; do
+      timed "gpu_bench_packet$w" 80 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
+        --scenes sponza sibenik bunny builtin:city --size 1920x1080 --rays frame ao diffuse --repeats 3 \
+        --configs kd:branched kd:rec bih:branched@split=sah --cpu-config "embree:packet$w" \
+        --json "$res/gpu_bench_packet$w.json"
+    done
+  fi
+  # The SAH BIH's build costs on the GPU, Sponza (docs/GPU.md; not by default): the node cost against the
+  # triangle test's (20) and the empty-space cut, with the kd-tree for reference.
+  if [[ " $steps " == *" gpu_bih_sweep "* ]]; then
+    configs=(kd:branched)
+    for c in 15 30 60 120; do
+      for e in 0.23 1; do configs+=("bih:branched@split=sah,traversal_cost=$c,empty_cut=$e"); done
+    done
+    configs+=("bih:branchless@split=sah,traversal_cost=60" "bih:branched@split=sah,traversal_cost=60,sah_max_leaf=64")
+    timed gpu_bih_sweep 120 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza sibenik \
+      --size 1920x1080 --rays frame diffuse --repeats 3 --configs "${configs[@]}" --json "$res/gpu_bih_sweep.json"
+  fi
+  # Builds on 1 and 16 threads (docs/BUILD_SPEED.md): the shared scenes, then the 1M-triangle forest.
+  if wanted builds; then
+    for t in 1 16; do
+      timed "builds_t$t" 40 "$run" cellrt_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza sibenik bunny teapot \
+        --size 16x16 --repeats 1 --builds 2 --threads "$t" --configs embree kd bih@split=sah --json "$res/builds_t$t.json"
+    done
+    for t in 1 16; do
+      timed "builds_forest_t$t" 40 "$run" cellrt_bench --scenes 'builtin:forest?tris=1000000' --size 16x16 --repeats 1 \
+        --builds 1 --threads "$t" --configs embree kd bih@split=sah --json "$res/builds_forest_t$t.json"
+    done
+  fi
+  # The build's curve over 1 to 16 threads, five builds each (not by default).
+  if [[ " $steps " == *" build_curve "* ]]; then
+    for t in 1 2 4 8 16; do
+      timed "build_curve_t$t" 30 "$run" cellrt_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza bunny --size 16x16 \
+        --repeats 1 --builds 5 --threads "$t" --configs embree kd bih@split=sah --json "$res/build_curve_t$t.json"
+    done
+  fi
+  # 16 ranks against one process (docs/DISTRIBUTED.md), in turn, five rounds; the frames compared byte for
+  # byte with the plain render's. The ranks' time is the frame's (rank 0's render_seconds), without
+  # start-up, loading and building. mpi16_cma asks Open MPI for its single-copy transport by name: it
+  # says so where the machine refuses it (yama's ptrace_scope, or a container without ptrace).
+  if [[ -x "$dir/bundle/bin/cellrt-mpi" ]] && wanted mpi16; then
+    cat /proc/sys/kernel/yama/ptrace_scope > "$res/mpi/ptrace_scope.txt" 2>&1 || true
+    timed mpi16 90 bash -c '
+      run="$1"; scene="$2"; res="$3"; frames="$4"
+      mpi=("$run" mpirun --oversubscribe --bind-to none)
+      for r in 1 2 3 4 5; do
+        for c in plain_t16 plain_t1 mpi16 mpi16_tile64 mpi8x2 mpi16_cma; do
+          case $c in
+            plain_t16) cmd=("$run" cellrt render "$scene" --threads 16) ;;
+            plain_t1) cmd=("$run" cellrt render "$scene" --threads 1) ;;
+            mpi16) cmd=("${mpi[@]}" -np 16 cellrt-mpi render "$scene" --threads 1) ;;
+            mpi16_tile64) cmd=("${mpi[@]}" -np 16 cellrt-mpi render "$scene" --threads 1 --tile 64) ;;
+            mpi8x2) cmd=("${mpi[@]}" -np 8 cellrt-mpi render "$scene" --threads 2) ;;
+            mpi16_cma) cmd=("${mpi[@]}" --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render "$scene" --threads 1) ;;
+          esac
+          "${cmd[@]}" --size 1920x1080 -o "$frames/$c.pfm" --stats "$res/mpi/$c.$r.json" --overwrite > /dev/null ||
+            echo "$c: status $?"
+          cmp "$frames/$c.pfm" "$frames/plain_t16.pfm" || echo "$c: the frame differs"
+        done
+      done' _ "$run" "$CELLRT_SCENES/sponza/sponza.json" "$res" "$dir/frames"
+  fi
+  # What holds 16 ranks back (not by default): tiles held ahead, tile edge, binding, ranks, transport.
+  if [[ -x "$dir/bundle/bin/cellrt-mpi" && " $steps " == *" mpi16_sweep "* ]]; then
+    timed mpi16_sweep 100 bash -c '
+      run="$1"; scene="$2"; res="$3"; frames="$4"
+      mpi=("$run" mpirun --oversubscribe)
+      for r in 1 2 3 4 5; do
+        for c in plain_t16 mpi16 mpi16_ahead6 mpi16_ahead12 mpi16_tile256 mpi16_core mpi15 mpi16_cma_ahead6 mpi4x4; do
+          case $c in
+            plain_t16) cmd=("$run" cellrt render "$scene" --threads 16) ;;
+            mpi16) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1) ;;
+            mpi16_ahead6) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --ahead 6) ;;
+            mpi16_ahead12) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --ahead 12) ;;
+            mpi16_tile256) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --tile 256) ;;
+            mpi16_core) cmd=("${mpi[@]}" --bind-to core -np 16 cellrt-mpi render "$scene" --threads 1) ;;
+            mpi15) cmd=("${mpi[@]}" --bind-to none -np 15 cellrt-mpi render "$scene" --threads 1) ;;
+            mpi16_cma_ahead6) cmd=("${mpi[@]}" --bind-to none --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi \
+              render "$scene" --threads 1 --ahead 6) ;;
+            mpi4x4) cmd=("${mpi[@]}" --bind-to none -np 4 cellrt-mpi render "$scene" --threads 4) ;;
+          esac
+          "${cmd[@]}" --size 1920x1080 -o "$frames/$c.pfm" --stats "$res/mpi_sweep/$c.$r.json" --overwrite > /dev/null ||
+            echo "$c: status $?"
+          cmp "$frames/$c.pfm" "$frames/plain_t16.pfm" || echo "$c: the frame differs"
+        done
+      done' _ "$run" "$CELLRT_SCENES/sponza/sponza.json" "$res" "$dir/frames"
+  fi
   # Last, as the step a short call may cut: asynchronous access, whose touches reach the node cache only.
-  timed cache_study_async 45 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda \
-    --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access async --sweeps node \
-    -o "$out/cache_study_async"
-  rm -rf "$CELLRT_TEST_CACHE"
+  wanted cache_study_async && timed cache_study_async 30 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" \
+    --device cuda --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access async --sweeps node \
+    -o "$res/cache_study_async"
   echo "  \"device\": true }" >> "$summary"
+  cp "$summary" "$out/summary.json"
   ;;
 *) usage ;;
 esac
