@@ -230,12 +230,23 @@ private:
         if (n == 0) root.box = Box3{Vec3(0.f), Vec3(0.f)};
         root.grid = root.box;
         tree.bounds = root.box;
-        const std::unique_ptr<Subtree<BihNode>> top = subtree(root);
+        // The reordered copy's arrays are fresh pages, faulted in as they are first written (1.6 ms
+        // for Sibenik's 75,000 triangles); a parallel build takes them on a thread that the top
+        // levels, one node at a time, leave idle.
+        std::unique_ptr<Subtree<BihNode>> top;
+        if (p_.threads == 1) {
+            top = subtree(root);
+            tree.triangles.resize(n);
+            tree.prims.resize(n);
+        } else {
+            tbb::task_group pages;
+            pages.run([&] { tree.triangles.resize(n); tree.prims.resize(n); });
+            top = subtree(root);
+            pages.wait();
+        }
         tree.nodes = {BihNode{}, BihNode::leaf(0, 0)};
         std::vector<std::uint32_t> no_indices;
         flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
-        tree.triangles.resize(n);
-        tree.prims.resize(n);
         for_blocks(n, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i) {
                 tree.triangles[i] = tris_[items_[i].triangle];

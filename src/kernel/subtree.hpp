@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <tbb/info.h>
@@ -46,16 +47,25 @@ inline std::uint32_t checked_node_index(std::size_t i, std::uint32_t max, const 
     return static_cast<std::uint32_t>(i);
 }
 
+// The nodes and leaf index entries `s` lays out, its pieces together.
+template <class Node>
+std::pair<std::size_t, std::size_t> laid_out_size(const Subtree<Node>& s) {
+    if (!s.left) return {s.nodes.size() - 1, s.indices.size()};
+    const auto [ln, li] = laid_out_size(*s.left);
+    const auto [rn, ri] = laid_out_size(*s.right);
+    return {2 + ln + rn, li + ri};
+}
+
 // Appends the subtree `s` whose root goes to nodes[slot] (already allocated).
 template <class Node>
-void flatten(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& nodes, std::vector<std::uint32_t>& indices,
-             std::uint32_t max_index, const char* structure) {
+void flatten_pieces(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& nodes,
+                    std::vector<std::uint32_t>& indices, std::uint32_t max_index, const char* structure) {
     if (s.left) {
         const auto pair = checked_node_index(nodes.size() + 1, max_index, structure) - 1;
         nodes.resize(nodes.size() + 2);
         nodes[slot] = s.nodes[0].with_index(pair);
-        flatten(*s.left, pair, nodes, indices, max_index, structure);
-        flatten(*s.right, pair + 1, nodes, indices, max_index, structure);
+        flatten_pieces(*s.left, pair, nodes, indices, max_index, structure);
+        flatten_pieces(*s.right, pair + 1, nodes, indices, max_index, structure);
         return;
     }
     const auto base = static_cast<std::uint32_t>(nodes.size());
@@ -69,6 +79,18 @@ void flatten(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& node
         const Node& n = s.nodes[i];
         nodes[place(i)] = n.is_leaf() ? n.with_index(first_index + n.first()) : n.with_index(place(n.children()));
     }
+}
+
+// Lays `s` out into `nodes` (whose element `slot` is its root's place) and `indices`. Their room is
+// taken at once: a parallel build's many pieces would otherwise grow them piece by piece, copying
+// and faulting in fresh pages each time (0.8 ms on one thread, 2.1 on two for Sibenik's BIH).
+template <class Node>
+void flatten(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& nodes, std::vector<std::uint32_t>& indices,
+             std::uint32_t max_index, const char* structure) {
+    const auto [more_nodes, more_indices] = laid_out_size(s);
+    nodes.reserve(nodes.size() + more_nodes);
+    indices.reserve(indices.size() + more_indices);
+    flatten_pieces(s, slot, nodes, indices, max_index, structure);
 }
 
 }  // namespace cellrt::detail
