@@ -36,7 +36,7 @@ for row in runs[0]:
                 if g:
                     ratios[ray_set].append(g[ray_set]["grays_per_s"] / other["cpu"][ray_set]["grays_per_s"])
         cells.append(f"{p['config']} {p['primary']['grays_per_s']:.2f} / {s['config']} {s[sec]['grays_per_s']:.2f}")
-        cells.append(f"{min(ratios['primary']):.0f} / {min(ratios[sec]):.0f}")
+        cells.append(f"{min(ratios['primary']):.1f} / {min(ratios[sec]):.1f}")
     best = {k: max(find(run, row)["cpu"][k]["grays_per_s"] for run in runs if find(run, row)) for k in ("primary", sec)}
     print(f"| {row['scene']} | {row['rays']} ({sec}) | {' | '.join(cells)} | "
           f"{best['primary'] * 1e3:.0f} / {best[sec] * 1e3:.0f} Mrays/s |")
