@@ -92,7 +92,8 @@ run)
     cp "$summary" "$out/summary.json"
     exit 3
   fi
-  wanted() { [[ -z "$steps" || " $steps " == *" $1 "* ]]; }
+  named() { [[ " $steps " == *" $1 "* ]]; }     # steps that run only when named
+  wanted() { [[ -z "$steps" ]] || named "$1"; }  # steps of the default run
   wanted gpu_tests && timed gpu_tests 120 "$run" cellrt_tests --gtest_filter='*Cuda*' --gtest_output="json:$res/gpu_tests.json"
   wanted gpu_bench && timed gpu_bench 170 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
     --scenes sponza sibenik bunny builtin:city --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$res/gpu_bench.json"
@@ -102,7 +103,7 @@ run)
     --repeats 3 --workers 1 2 4 8 16 --configs embree:single kd+auto bih+auto --json "$res/scaling_pull_16core.json"
   # Embree's packets as the yardstick (gpu_bench's default is rtcIntersect1), against the fastest
   # configuration of each tree in memory mode (a) (not by default).
-  if [[ " $steps " == *" gpu_bench_packets "* ]]; then
+  if named gpu_bench_packets; then
     for w in 8 16; do
       timed "gpu_bench_packet$w" 80 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
         --scenes sponza sibenik bunny builtin:city --size 1920x1080 --rays frame ao diffuse --repeats 3 \
@@ -112,7 +113,7 @@ run)
   fi
   # The SAH BIH's build costs on the GPU, Sponza (docs/GPU.md; not by default): the node cost against the
   # triangle test's (20) and the empty-space cut, with the kd-tree for reference.
-  if [[ " $steps " == *" gpu_bih_sweep "* ]]; then
+  if named gpu_bih_sweep; then
     configs=(kd:branched)
     for c in 15 30 60 120; do
       for e in 0.23 1; do configs+=("bih:branched@split=sah,traversal_cost=$c,empty_cut=$e"); done
@@ -133,61 +134,55 @@ run)
     done
   fi
   # The build's curve over 1 to 16 threads, five builds each (not by default).
-  if [[ " $steps " == *" build_curve "* ]]; then
+  if named build_curve; then
     for t in 1 2 4 8 16; do
       timed "build_curve_t$t" 30 "$run" cellrt_bench --scenes-dir "$CELLRT_SCENES" --scenes sponza bunny --size 16x16 \
         --repeats 1 --builds 5 --threads "$t" --configs embree kd bih@split=sah --json "$res/build_curve_t$t.json"
     done
   fi
-  # 16 ranks against one process (docs/DISTRIBUTED.md), in turn, five rounds; the frames compared byte for
-  # byte with the plain render's. The ranks' time is the frame's (rank 0's render_seconds), without
-  # start-up, loading and building. mpi16_cma asks Open MPI for its single-copy transport by name: it
+  # Runs of `cellrt render` and `cellrt-mpi render` of Sponza at 1080p (docs/DISTRIBUTED.md), five rounds
+  # with the configurations in turn, each frame compared byte for byte with the first configuration's;
+  # each run's time is rank 0's render_seconds in its --stats file, without start-up, loading and
+  # building. mpi_rounds INTO NAME=PROGRAM ARGS...
+  mpi_rounds() {
+    local into="$1" first="${2%%=*}" spec name args r
+    shift
+    for r in 1 2 3 4 5; do
+      for spec in "$@"; do
+        name="${spec%%=*}"
+        read -ra args <<<"${spec#*=}"
+        "$run" "${args[@]}" --size 1920x1080 -o "$frames/$name.pfm" --stats "$into/$name.$r.json" --overwrite \
+          > /dev/null || echo "$name: status $?"
+        cmp "$frames/$name.pfm" "$frames/$first.pfm" || echo "$name: the frame differs"
+      done
+    done
+  }
+  frames="$dir/frames" sponza="$CELLRT_SCENES/sponza/sponza.json"
+  export -f mpi_rounds
+  export run frames
+  plain="cellrt render $sponza"
+  mpi="mpirun --oversubscribe --bind-to none"
+  # 16 ranks against one process. mpi16_cma asks Open MPI for its single-copy transport by name: it
   # says so where the machine refuses it (yama's ptrace_scope, or a container without ptrace).
   if [[ -x "$dir/bundle/bin/cellrt-mpi" ]] && wanted mpi16; then
     cat /proc/sys/kernel/yama/ptrace_scope > "$res/mpi/ptrace_scope.txt" 2>&1 || true
-    timed mpi16 90 bash -c '
-      run="$1"; scene="$2"; res="$3"; frames="$4"
-      mpi=("$run" mpirun --oversubscribe --bind-to none)
-      for r in 1 2 3 4 5; do
-        for c in plain_t16 plain_t1 mpi16 mpi16_tile64 mpi8x2 mpi16_cma; do
-          case $c in
-            plain_t16) cmd=("$run" cellrt render "$scene" --threads 16) ;;
-            plain_t1) cmd=("$run" cellrt render "$scene" --threads 1) ;;
-            mpi16) cmd=("${mpi[@]}" -np 16 cellrt-mpi render "$scene" --threads 1) ;;
-            mpi16_tile64) cmd=("${mpi[@]}" -np 16 cellrt-mpi render "$scene" --threads 1 --tile 64) ;;
-            mpi8x2) cmd=("${mpi[@]}" -np 8 cellrt-mpi render "$scene" --threads 2) ;;
-            mpi16_cma) cmd=("${mpi[@]}" --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render "$scene" --threads 1) ;;
-          esac
-          "${cmd[@]}" --size 1920x1080 -o "$frames/$c.pfm" --stats "$res/mpi/$c.$r.json" --overwrite > /dev/null ||
-            echo "$c: status $?"
-          cmp "$frames/$c.pfm" "$frames/plain_t16.pfm" || echo "$c: the frame differs"
-        done
-      done' _ "$run" "$CELLRT_SCENES/sponza/sponza.json" "$res" "$dir/frames"
+    timed mpi16 90 bash -c 'mpi_rounds "$@"' _ "$res/mpi" "plain_t16=$plain --threads 16" \
+      "plain_t1=$plain --threads 1" "mpi16=$mpi -np 16 cellrt-mpi render $sponza --threads 1" \
+      "mpi16_tile64=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 64" \
+      "mpi8x2=$mpi -np 8 cellrt-mpi render $sponza --threads 2" \
+      "mpi16_cma=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1"
   fi
   # What holds 16 ranks back (not by default): tiles held ahead, tile edge, binding, ranks, transport.
-  if [[ -x "$dir/bundle/bin/cellrt-mpi" && " $steps " == *" mpi16_sweep "* ]]; then
-    timed mpi16_sweep 100 bash -c '
-      run="$1"; scene="$2"; res="$3"; frames="$4"
-      mpi=("$run" mpirun --oversubscribe)
-      for r in 1 2 3 4 5; do
-        for c in plain_t16 mpi16 mpi16_ahead6 mpi16_ahead12 mpi16_tile256 mpi16_core mpi15 mpi16_cma_ahead6 mpi4x4; do
-          case $c in
-            plain_t16) cmd=("$run" cellrt render "$scene" --threads 16) ;;
-            mpi16) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1) ;;
-            mpi16_ahead6) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --ahead 6) ;;
-            mpi16_ahead12) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --ahead 12) ;;
-            mpi16_tile256) cmd=("${mpi[@]}" --bind-to none -np 16 cellrt-mpi render "$scene" --threads 1 --tile 256) ;;
-            mpi16_core) cmd=("${mpi[@]}" --bind-to core -np 16 cellrt-mpi render "$scene" --threads 1) ;;
-            mpi15) cmd=("${mpi[@]}" --bind-to none -np 15 cellrt-mpi render "$scene" --threads 1) ;;
-            mpi16_cma_ahead6) cmd=("${mpi[@]}" --bind-to none --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi \
-              render "$scene" --threads 1 --ahead 6) ;;
-            mpi4x4) cmd=("${mpi[@]}" --bind-to none -np 4 cellrt-mpi render "$scene" --threads 4) ;;
-          esac
-          "${cmd[@]}" --size 1920x1080 -o "$frames/$c.pfm" --stats "$res/mpi_sweep/$c.$r.json" --overwrite > /dev/null ||
-            echo "$c: status $?"
-          cmp "$frames/$c.pfm" "$frames/plain_t16.pfm" || echo "$c: the frame differs"
-        done
-      done' _ "$run" "$CELLRT_SCENES/sponza/sponza.json" "$res" "$dir/frames"
+  if [[ -x "$dir/bundle/bin/cellrt-mpi" ]] && named mpi16_sweep; then
+    timed mpi16_sweep 100 bash -c 'mpi_rounds "$@"' _ "$res/mpi_sweep" "plain_t16=$plain --threads 16" \
+      "mpi16=$mpi -np 16 cellrt-mpi render $sponza --threads 1" \
+      "mpi16_ahead6=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --ahead 6" \
+      "mpi16_ahead12=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --ahead 12" \
+      "mpi16_tile256=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 256" \
+      "mpi16_core=mpirun --oversubscribe --bind-to core -np 16 cellrt-mpi render $sponza --threads 1" \
+      "mpi15=$mpi -np 15 cellrt-mpi render $sponza --threads 1" \
+      "mpi16_cma_ahead6=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1 --ahead 6" \
+      "mpi4x4=$mpi -np 4 cellrt-mpi render $sponza --threads 4"
   fi
   # Last, as the step a short call may cut: asynchronous access, whose touches reach the node cache only.
   wanted cache_study_async && timed cache_study_async 30 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" \
