@@ -233,14 +233,17 @@ private:
         // The reordered copy's arrays are fresh pages, faulted in as they are first written (1.6 ms
         // for Sibenik's 75,000 triangles); a parallel build takes them on a thread that the top
         // levels, one node at a time, leave idle.
+        auto make_arrays = [&] {
+            tree.triangles.resize(n);
+            tree.prims.resize(n);
+        };
         std::unique_ptr<Subtree<BihNode>> top;
         if (p_.threads == 1) {
             top = subtree(root);
-            tree.triangles.resize(n);
-            tree.prims.resize(n);
+            make_arrays();
         } else {
             tbb::task_group pages;
-            pages.run([&] { tree.triangles.resize(n); tree.prims.resize(n); });
+            pages.run(make_arrays);
             top = subtree(root);
             pages.wait();
         }
