@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "accel/routed_accelerator.hpp"
@@ -385,31 +386,44 @@ TEST(Bvh, RaysAlongItsOwnBoxFaces) {
 // The stream and packet traversals on batches of every size, from one ray to the whole suite in one
 // call (the per-thread scratch grows and is reused; packets of eight rays and a short last one), with
 // invalid rays mixed in: the brute-force answers, and every ray counted once.
-TEST(Bvh, StreamsAndPacketsOfAnySizeMatchBruteForce) {
+// Every traversal in batches of any size, invalid rays among them, on every instruction set. The
+// single-ray kernel walks two rays of a batch at once (interleaved_batch): each walk is the one-ray
+// walk step for step, so its work per ray is the same whatever the batch (a batch of one walks
+// alone), and a batch's last ray may walk alone too.
+TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& suite = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
     std::vector<Ray> rays = test::sanitized_sample(suite.rays);
     for (std::size_t i = 0; i < rays.size(); i += 97) rays[i].dir = {0.f, 0.f, 0.f};  // invalid: no hit
     const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
-    for (const char* traversal : {"stream", "packet"}) {
-        const auto accel = make_accelerator(scene.triangles, parse_accel_config(std::string("bvh:") + traversal));
-        EXPECT_EQ(accel->stats().traversal, traversal);
-        for (std::size_t batch : {std::size_t{1}, std::size_t{7}, std::size_t{9}, std::size_t{256}, std::size_t{1000},
-                                  rays.size()}) {
-            std::vector<Hit> hits(rays.size());
-            std::vector<std::uint8_t> occluded(rays.size(), 2);
-            TraversalCounters counters;
-            for (std::size_t i = 0; i < rays.size(); i += batch) {
-                const std::size_t n = std::min(batch, rays.size() - i);
-                accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n), &counters);
-                accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
+    for (detail::Isa isa : detail::available_isas()) {
+        for (const char* traversal : {"wide", "stream", "packet"}) {
+            const std::string config = std::string("bvh:") + traversal + "+" + detail::to_string(isa);
+            const auto accel = make_accelerator(scene.triangles, parse_accel_config(config));
+            EXPECT_EQ(accel->stats().traversal, traversal);
+            std::optional<TraversalCounters> alone;
+            for (std::size_t batch : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{7}, std::size_t{256},
+                                      std::size_t{1000}, rays.size()}) {
+                std::vector<Hit> hits(rays.size());
+                std::vector<std::uint8_t> occluded(rays.size(), 2);
+                TraversalCounters counters;
+                for (std::size_t i = 0; i < rays.size(); i += batch) {
+                    const std::size_t n = std::min(batch, rays.size() - i);
+                    accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n), &counters);
+                    accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n), &counters);
+                }
+                std::size_t bad = 0;
+                for (std::size_t i = 0; i < rays.size(); ++i)
+                    bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
+                EXPECT_EQ(bad, 0u) << config << ", batches of " << batch;
+                EXPECT_EQ(counters.rays, 2 * rays.size());
+                EXPECT_GT(counters.nodes, 0u);
+                if (traversal != std::string("wide")) continue;
+                if (!alone) alone = counters;
+                EXPECT_EQ(counters.nodes, alone->nodes) << config << ", batches of " << batch;
+                EXPECT_EQ(counters.leaves, alone->leaves) << config << ", batches of " << batch;
+                EXPECT_EQ(counters.triangles, alone->triangles) << config << ", batches of " << batch;
             }
-            std::size_t bad = 0;
-            for (std::size_t i = 0; i < rays.size(); ++i)
-                bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
-            EXPECT_EQ(bad, 0u) << traversal << ", batches of " << batch;
-            EXPECT_EQ(counters.rays, rays.size());
-            EXPECT_GT(counters.nodes, 0u);
         }
     }
 }

@@ -228,60 +228,88 @@ inline void push_children(const BvhNode& node, unsigned met, F entries, std::uin
     size += __builtin_popcount(met);
 }
 
+// One ray's walk through the tree: what it carries from one step to the next. The stacks are the
+// caller's, so that a batch can keep several walks going (interleaved_batch, below).
+template <class Query>
+struct BvhWalk {
+    // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was
+    // met within it, so its stack needs no entry distances and no pop is culled.
+    static constexpr bool kCulls = !Query::kAnyHit;
+    static constexpr int kStack = kBvhStackSize + kBvhStackSlack;
+    BoxRay box;
+    LeafRay leaf;
+    Query q;
+    std::uint32_t word;  // the node or leaf visited next
+    int size = 0;        // children on the stack
+    std::uint32_t* word_stack;
+    float* entry_stack;  // null for an any-hit query
+
+    BvhWalk(const BoxRay& b, const LeafRay& l, const Query& query, std::uint32_t root, std::uint32_t* words,
+            float* entries)
+        : box(b), leaf(l), q(query), word(root), word_stack(words), entry_stack(kCulls ? entries : nullptr) {}
+};
+
+// How a step left its walk.
+enum class BvhStep { on, done, answered };
+
+// One step of a walk: the node or leaf at `w.word`, then the next word, from the node or the stack.
+// `done` when the stack runs out, `answered` when an any-hit query is.
+template <class Query, class Counters>
+[[gnu::always_inline]] inline BvhStep bvh_step(const BvhNode* nodes, const BvhLeaf* leaves, BvhWalk<Query>& w,
+                                               Counters& c) {
+    constexpr bool kCulls = BvhWalk<Query>::kCulls;
+    if (BvhNode::is_leaf(w.word)) {
+        if (test_leaf(leaves[BvhNode::leaf_index(w.word)], BvhNode::leaf_count(w.word), w.leaf, w.q, c))
+            return BvhStep::answered;
+    } else {
+        c.node();
+        const BvhNode& node = nodes[w.word];
+        F entry;
+        const I met_lanes = meet_children_lanes(node, w.box, w.q.cull_t(), entry);
+        const unsigned met = bits(met_lanes);
+        if (met) {
+            // One child met (the common case deep in the tree): go there. Several: the nearest goes
+            // first, the others wait unsorted (sorting them costs more on incoherent rays than the
+            // order saves, and a popped child past the answer is skipped). An any-hit query takes the
+            // first child met, as Embree's any-hit traversal does: any occluder answers it, and the
+            // next node's address then waits on no lane minimum (measured faster than the nearest,
+            // and than testing the leaves met first: docs/INCOHERENT.md, "Third round").
+            if ((met & (met - 1)) == 0) {
+                w.word = node.child[__builtin_ctz(met)];
+                return BvhStep::on;
+            }
+            unsigned next = __builtin_ctz(met);
+            if constexpr (!Query::kAnyHit) next = nearest_lane(entry, met_lanes);
+            w.word = node.child[next];
+            push_children(node, met & ~(1u << next), entry, w.word_stack, kCulls ? w.entry_stack : nullptr, w.size);
+            return BvhStep::on;
+        }
+    }
+    for (;;) {
+        if (w.size == 0) return BvhStep::done;
+        --w.size;
+        if constexpr (kCulls) {
+            if (w.entry_stack[w.size] > w.q.cull_t()) continue;
+        }
+        break;
+    }
+    w.word = w.word_stack[w.size];
+    return BvhStep::on;
+}
+
 // One ray through the subtree of `root` (an inner node's word; 0 is the whole tree's root).
 template <class Query, class Counters>
 bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray, const LeafRay& leaf_ray,
                        std::uint32_t root, Query& q, Counters& c) {
-    // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was met
-    // within it, so its stack needs no entry distances and no pop is culled.
-    constexpr bool kCulls = !Query::kAnyHit;
-    std::uint32_t word_stack[kBvhStackSize + kBvhStackSlack];
-    float entry_stack[kCulls ? kBvhStackSize + kBvhStackSlack : 1];
-    int size = 0;
-    std::uint32_t word = root;
+    std::uint32_t word_stack[BvhWalk<Query>::kStack];
+    float entry_stack[BvhWalk<Query>::kCulls ? BvhWalk<Query>::kStack : 1];
+    BvhWalk<Query> w(box_ray, leaf_ray, q, root, word_stack, entry_stack);
     for (;;) {
-        if (BvhNode::is_leaf(word)) {
-            if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), leaf_ray, q, c)) return true;
-        } else {
-            c.node();
-            const BvhNode& node = nodes[word];
-            F entry;
-            const I met_lanes = meet_children_lanes(node, box_ray, q.cull_t(), entry);
-            const unsigned met = bits(met_lanes);
-            if (met) {
-                // One child met (the common case deep in the tree): go there. Several: the nearest
-                // goes first, the others wait unsorted (sorting them costs more on incoherent rays
-                // than the order saves, and a popped child past the answer is skipped). An any-hit
-                // query takes the first child met, as Embree's any-hit traversal does: any occluder
-                // answers it, and the next node's address then waits on no lane minimum (measured
-                // faster than the nearest, and than testing the leaves met first:
-                // docs/INCOHERENT.md, "Third round").
-                if ((met & (met - 1)) == 0) {
-                    word = node.child[__builtin_ctz(met)];
-                    continue;
-                }
-                unsigned next = __builtin_ctz(met);
-                if constexpr (!Query::kAnyHit) next = nearest_lane(entry, met_lanes);
-                word = node.child[next];
-                push_children(node, met & ~(1u << next), entry, word_stack, kCulls ? entry_stack : nullptr, size);
-                continue;
-            }
-        }
-        for (;;) {
-            if (size == 0) return false;
-            --size;
-            if constexpr (kCulls) {
-                if (entry_stack[size] > q.cull_t()) continue;
-            }
-            break;
-        }
-        word = word_stack[size];
+        const BvhStep s = bvh_step(nodes, leaves, w, c);
+        if (s == BvhStep::on) continue;
+        q = w.q;
+        return s == BvhStep::answered;
     }
-}
-
-template <class Query, class Counters>
-bool traverse_bvh(const BvhNode* nodes, const BvhLeaf* leaves, const TraversalRay& r, Query& q, Counters& c) {
-    return traverse_bvh_from(nodes, leaves, BoxRay(r), LeafRay(r.watertight), 0, q, c);
 }
 
 // The answers for a tree without triangles: nothing is hit.
@@ -291,21 +319,76 @@ void miss_all(std::span<const Ray> rays, std::span<Answer> out, TraversalCounter
     if (counters) counters->rays += rays.size();
 }
 
-// The batch entry points: one kernel per query, over a batch. The root's box test is the scene box
-// test, so rays are not clipped to the scene first.
+// K rays' walks interleaved step by step on one thread. A random ray's steps wait on memory, each
+// node's address on the last node's bytes; one walk at a time keeps one such load in flight. With
+// the steps of K independent walks in turn, the core issues the next walk's load while the last
+// one's waits (and a load issued under a mispredicted branch still fetches its line), so up to K
+// misses overlap: the group prefetching of Chen, Ailamaki, Gibbons and Mowry, "Improving Hash Join
+// Performance through Prefetching" (ICDE 2004), applied to traversal. Each walk is the single-ray
+// walk above, step for step, so the answers are its answers. `answer(i, query, step)` is called once
+// per ray of the batch: with a null query for an invalid ray (ray.hpp), which hits nothing.
+template <int K, class Query, class Counters, class Answer>
+void interleaved_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, Answer&& answer) {
+    using Walk = BvhWalk<Query>;
+    std::uint32_t word_stacks[K][Walk::kStack];
+    float entry_stacks[K][Walk::kCulls ? Walk::kStack : 1];
+    std::optional<Walk> walks[K];
+    std::size_t index[K];
+    std::size_t next = 0;
+    // Starts walk k on the batch's next valid ray, answering the invalid ones on the way; false when
+    // the batch has no ray left.
+    const auto start = [&](int k) {
+        for (; next < rays.size(); ++next) {
+            const Ray& ray = rays[next];
+            if (!is_valid(ray)) {
+                answer(next, static_cast<const Query*>(nullptr), BvhStep::done);
+                continue;
+            }
+            const TraversalRay r(ray, tree.bounds);
+            walks[k].emplace(BoxRay(r), LeafRay(r.watertight), Query(r), 0u, word_stacks[k], entry_stacks[k]);
+            index[k] = next++;
+            return true;
+        }
+        return false;
+    };
+    unsigned live = 0;
+    for (int k = 0; k < K; ++k)
+        if (start(k)) live |= 1u << k;
+    while (live) {
+#pragma GCC unroll 4
+        for (int k = 0; k < K; ++k) {
+            if (!(live >> k & 1)) continue;
+            const BvhStep s = bvh_step(tree.nodes.data(), tree.leaves.data(), *walks[k], c);
+            if (s == BvhStep::on) continue;
+            answer(index[k], &walks[k]->q, s);
+            if (!start(k)) live &= ~(1u << k);
+        }
+    }
+}
+
+// The rays of a batch walked at once (interleaved_batch): measured per ray kind and scene in
+// docs/INCOHERENT.md, "Eleventh round".
+inline constexpr int kBvhWalks = 2;
+
+// The batch entry points: one kernel per query, over a batch, kBvhWalks rays at a time. The root's
+// box test is the scene box test, so rays are not clipped to the scene first.
 inline void closest_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
                           TraversalCounters* counters) {
     if (tree.nodes.empty()) return miss_all(rays, hits, counters);
-    closest_hits(tree.bounds, rays, hits, counters, [&](const TraversalRay& r, ClosestHit& q, auto& count) {
-        return traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
+    with_counters(counters, rays.size(), [&](auto& count) {
+        interleaved_batch<kBvhWalks, ClosestHit>(tree, rays, count, [&](std::size_t i, const ClosestHit* q, BvhStep) {
+            hits[i] = q ? q->result() : Hit{};
+        });
     });
 }
 
 inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                       TraversalCounters* counters) {
     if (tree.nodes.empty()) return miss_all(rays, occluded, counters);
-    any_hits(tree.bounds, rays, occluded, counters, [&](const TraversalRay& r, AnyHit& q, auto& count) {
-        return traverse_bvh(tree.nodes.data(), tree.leaves.data(), r, q, count);
+    with_counters(counters, rays.size(), [&](auto& count) {
+        interleaved_batch<kBvhWalks, AnyHit>(tree, rays, count, [&](std::size_t i, const AnyHit*, BvhStep s) {
+            occluded[i] = s == BvhStep::answered ? 1 : 0;
+        });
     });
 }
 
