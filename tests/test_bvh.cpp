@@ -387,9 +387,9 @@ TEST(Bvh, RaysAlongItsOwnBoxFaces) {
 // call (the per-thread scratch grows and is reused; packets of eight rays and a short last one), with
 // invalid rays mixed in: the brute-force answers, and every ray counted once.
 // Every traversal in batches of any size, invalid rays among them, on every instruction set. The
-// single-ray kernel walks two rays of a batch at once (interleaved_batch): each walk is the one-ray
-// walk step for step, so its work per ray is the same whatever the batch (a batch of one walks
-// alone), and a batch's last ray may walk alone too.
+// paired traversal walks two rays of a batch at once (paired_batch), each the single-ray walk step
+// for step, so its work per ray is the single-ray kernel's whatever the batch (a batch of one walks
+// alone, and a batch's last ray may walk alone too).
 TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& suite = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
@@ -397,11 +397,11 @@ TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     for (std::size_t i = 0; i < rays.size(); i += 97) rays[i].dir = {0.f, 0.f, 0.f};  // invalid: no hit
     const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
     for (detail::Isa isa : detail::available_isas()) {
-        for (const char* traversal : {"wide", "stream", "packet"}) {
+        std::optional<TraversalCounters> alone;  // the single-ray kernel's, one ray a batch
+        for (const char* traversal : {"wide", "paired", "stream", "packet"}) {
             const std::string config = std::string("bvh:") + traversal + "+" + detail::to_string(isa);
             const auto accel = make_accelerator(scene.triangles, parse_accel_config(config));
             EXPECT_EQ(accel->stats().traversal, traversal);
-            std::optional<TraversalCounters> alone;
             for (std::size_t batch : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{7}, std::size_t{256},
                                       std::size_t{1000}, rays.size()}) {
                 std::vector<Hit> hits(rays.size());
@@ -418,7 +418,7 @@ TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
                 EXPECT_EQ(bad, 0u) << config << ", batches of " << batch;
                 EXPECT_EQ(counters.rays, 2 * rays.size());
                 EXPECT_GT(counters.nodes, 0u);
-                if (traversal != std::string("wide")) continue;
+                if (traversal != std::string("wide") && traversal != std::string("paired")) continue;
                 if (!alone) alone = counters;
                 EXPECT_EQ(counters.nodes, alone->nodes) << config << ", batches of " << batch;
                 EXPECT_EQ(counters.leaves, alone->leaves) << config << ", batches of " << batch;
@@ -796,9 +796,9 @@ TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
         EXPECT_EQ(occluded, ref.occluded);
         EXPECT_EQ(counters.rays, ref.rays.size());
     }
-    // Each path answered some of them: "closest packets P single S stream T bvh-packets B; any ...".
+    // Each path answered some of them: "closest packets P paired S stream T bvh-packets B; any ...".
     const std::string routes = routed->stats().setting("routed").value_or("");
-    for (const char* path : {" packets ", " single ", " stream ", " bvh-packets "}) {
+    for (const char* path : {" packets ", " paired ", " stream ", " bvh-packets "}) {
         const std::size_t at = routes.find(path);
         ASSERT_NE(at, std::string::npos) << routes;
         EXPECT_GT(std::stod(routes.substr(at + std::string(path).size())), 0.0) << path << "in: " << routes;

@@ -40,8 +40,9 @@ struct RoutePath {
 
 class RoutedAccelerator final : public Accelerator {
 public:
-    // paths[0] is the tree's packets and paths[1] the BVH's single rays (coherence names one of them);
-    // the measured route may hold views of the BVH's tree traced otherwise (bvh_with_traversal) after them.
+    // paths[0] is the tree's packets and paths[1] the BVH's single rays, two at a time (coherence names
+    // one of them); the measured route may hold views of the BVH's tree traced otherwise
+    // (bvh_with_traversal) after them.
     RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
         : paths_(std::move(paths)), threshold_(threshold), packets_(std::move(packets)), measured_(measured),
           pickers_{RoutePicker(count()), RoutePicker(count()), RoutePicker(count()), RoutePicker(count())} {}
@@ -114,7 +115,7 @@ private:
     void count_rays(int query, int path, std::size_t n) const {
         routed_[query][path].fetch_add(n, std::memory_order_relaxed);
     }
-    // Which path answered how many rays so far, per query: "closest packets/single/stream/bvh-packets,
+    // Which path answered how many rays so far, per query: "closest packets/paired/stream/bvh-packets,
     // any ..." as fractions, for the benchmark's report of what the route chose; then, per kind of batch that
     // was timed, the batches counted and each path's time per ray in nanoseconds (0: none counted).
     std::string routed() const {
@@ -233,13 +234,16 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     part.kind = tree.kind;
     part.params = tree.params;
     std::unique_ptr<Accelerator> coherent = make_accelerator(triangles, part);
+    // The BVH's single rays two at a time (bvh:paired): faster than one at a time on incoherent
+    // batches, which are the ones this path is for (docs/INCOHERENT.md, "Eleventh round").
     part.kind = "bvh";
+    part.traversal = "paired";
     part.params.clear();
     std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, part);
     std::vector<RoutePath> paths;
     paths.push_back({"packets", std::move(coherent)});
     const Accelerator& tree_of_bvh = *bvh;
-    paths.push_back({"single", std::move(bvh)});
+    paths.push_back({"paired", std::move(bvh)});
     // Coherence alone names neither the streams nor the BVH's packets, so only the measured route
     // holds them: views of the BVH's tree, not further builds.
     if (streams && measured) paths.push_back({"stream", bvh_with_traversal(tree_of_bvh, "stream")});

@@ -8,11 +8,14 @@ namespace cellrt {
 namespace {
 
 // The traversals, in the order of bvh_traversals().
-enum class Traversal { wide, stream, packet };
+enum class Traversal { wide, stream, packet, paired };
 
 Traversal traversal_named(const std::string& name) {
     const std::string& chosen = detail::choose_traversal(bvh_traversals(), name, "bvh");
-    return chosen == "stream" ? Traversal::stream : chosen == "packet" ? Traversal::packet : Traversal::wide;
+    return chosen == "stream"   ? Traversal::stream
+           : chosen == "packet" ? Traversal::packet
+           : chosen == "paired" ? Traversal::paired
+                                : Traversal::wide;
 }
 
 class BvhAccelerator final : public Accelerator {
@@ -62,12 +65,14 @@ private:
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
         (traversal_ == Traversal::stream   ? kernels_.stream_closest
          : traversal_ == Traversal::packet ? kernels_.packet_closest
+         : traversal_ == Traversal::paired ? kernels_.paired_closest
                                            : kernels_.closest)(tree(), rays, hits, counters);
     }
     void do_occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                      TraversalCounters* counters) const override {
         (traversal_ == Traversal::stream   ? kernels_.stream_any
          : traversal_ == Traversal::packet ? kernels_.packet_any
+         : traversal_ == Traversal::paired ? kernels_.paired_any
                                            : kernels_.any)(tree(), rays, occluded, counters);
     }
 
@@ -107,7 +112,7 @@ const ParamTable& bvh_params() {
 // A function's static, not a namespace-scope one: the registry copies the list when it is first used,
 // which may be during another unit's static initialisation (a test's list of configurations).
 const std::vector<std::string>& bvh_traversals() {
-    static const std::vector<std::string> names{"wide", "stream", "packet"};
+    static const std::vector<std::string> names{"wide", "stream", "packet", "paired"};
     return names;
 }
 

@@ -24,6 +24,9 @@ struct BvhKernels {
     // The packet traversal (bvh_packet.inl): eight consecutive rays of the batch, one per lane.
     void (*packet_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*packet_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+    // Two rays of the batch walked at once (bvh_kernels.inl, paired_batch).
+    void (*paired_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
+    void (*paired_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
     const char* isa;  // the instruction set they are compiled for
 };
 

@@ -228,44 +228,29 @@ inline void push_children(const BvhNode& node, unsigned met, F entries, std::uin
     size += __builtin_popcount(met);
 }
 
-// One ray's walk through the tree: what it carries from one step to the next. The stacks are the
-// caller's, so that a batch can keep several walks going (interleaved_batch, below).
-template <class Query>
-struct BvhWalk {
-    // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was
-    // met within it, so its stack needs no entry distances and no pop is culled.
-    static constexpr bool kCulls = !Query::kAnyHit;
-    static constexpr int kStack = kBvhStackSize + kBvhStackSlack;
-    BoxRay box;
-    LeafRay leaf;
-    Query q;
-    std::uint32_t word;  // the node or leaf visited next
-    int size = 0;        // children on the stack
-    std::uint32_t* word_stack;
-    float* entry_stack;  // null for an any-hit query
-
-    BvhWalk(const BoxRay& b, const LeafRay& l, const Query& query, std::uint32_t root, std::uint32_t* words,
-            float* entries)
-        : box(b), leaf(l), q(query), word(root), word_stack(words), entry_stack(kCulls ? entries : nullptr) {}
-};
-
-// How a step left its walk.
+// How a step left its ray's walk.
 enum class BvhStep { on, done, answered };
 
-// One step of a walk: the node or leaf at `w.word`, then the next word, from the node or the stack.
-// `done` when the stack runs out, `answered` when an any-hit query is.
+// One step of a ray's walk through the tree: the node or leaf at `word`, then the next word, from the
+// node or from the stack (`size` children on it). `done` when the stack runs out, `answered` when an
+// any-hit query is. The walk's word and stack size are the caller's locals, passed by reference to
+// this inlined step, so that they stay in registers (members of a walk in memory cost 11 % more
+// instructions: docs/INCOHERENT.md, "Eleventh round").
 template <class Query, class Counters>
-[[gnu::always_inline]] inline BvhStep bvh_step(const BvhNode* nodes, const BvhLeaf* leaves, BvhWalk<Query>& w,
-                                               Counters& c) {
-    constexpr bool kCulls = BvhWalk<Query>::kCulls;
-    if (BvhNode::is_leaf(w.word)) {
-        if (test_leaf(leaves[BvhNode::leaf_index(w.word)], BvhNode::leaf_count(w.word), w.leaf, w.q, c))
+[[gnu::always_inline]] inline BvhStep bvh_step(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray,
+                                               const LeafRay& leaf_ray, Query& q, std::uint32_t& word, int& size,
+                                               std::uint32_t* word_stack, float* entry_stack, Counters& c) {
+    // An any-hit query's cull distance is fixed (tfar plus the margin) and every child it pushes was met
+    // within it, so its stack needs no entry distances and no pop is culled.
+    constexpr bool kCulls = !Query::kAnyHit;
+    if (BvhNode::is_leaf(word)) {
+        if (test_leaf(leaves[BvhNode::leaf_index(word)], BvhNode::leaf_count(word), leaf_ray, q, c))
             return BvhStep::answered;
     } else {
         c.node();
-        const BvhNode& node = nodes[w.word];
+        const BvhNode& node = nodes[word];
         F entry;
-        const I met_lanes = meet_children_lanes(node, w.box, w.q.cull_t(), entry);
+        const I met_lanes = meet_children_lanes(node, box_ray, q.cull_t(), entry);
         const unsigned met = bits(met_lanes);
         if (met) {
             // One child met (the common case deep in the tree): go there. Several: the nearest goes
@@ -275,40 +260,45 @@ template <class Query, class Counters>
             // next node's address then waits on no lane minimum (measured faster than the nearest,
             // and than testing the leaves met first: docs/INCOHERENT.md, "Third round").
             if ((met & (met - 1)) == 0) {
-                w.word = node.child[__builtin_ctz(met)];
+                word = node.child[__builtin_ctz(met)];
                 return BvhStep::on;
             }
             unsigned next = __builtin_ctz(met);
             if constexpr (!Query::kAnyHit) next = nearest_lane(entry, met_lanes);
-            w.word = node.child[next];
-            push_children(node, met & ~(1u << next), entry, w.word_stack, kCulls ? w.entry_stack : nullptr, w.size);
+            word = node.child[next];
+            push_children(node, met & ~(1u << next), entry, word_stack, kCulls ? entry_stack : nullptr, size);
             return BvhStep::on;
         }
     }
     for (;;) {
-        if (w.size == 0) return BvhStep::done;
-        --w.size;
+        if (size == 0) return BvhStep::done;
+        --size;
         if constexpr (kCulls) {
-            if (w.entry_stack[w.size] > w.q.cull_t()) continue;
+            if (entry_stack[size] > q.cull_t()) continue;
         }
         break;
     }
-    w.word = w.word_stack[w.size];
+    word = word_stack[size];
     return BvhStep::on;
 }
+
+// A ray's stacks: child words and, for a closest-hit query, their entry distances.
+template <class Query>
+struct BvhStacks {
+    std::uint32_t words[kBvhStackSize + kBvhStackSlack];
+    float entries[Query::kAnyHit ? 1 : kBvhStackSize + kBvhStackSlack];
+};
 
 // One ray through the subtree of `root` (an inner node's word; 0 is the whole tree's root).
 template <class Query, class Counters>
 bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray, const LeafRay& leaf_ray,
                        std::uint32_t root, Query& q, Counters& c) {
-    std::uint32_t word_stack[BvhWalk<Query>::kStack];
-    float entry_stack[BvhWalk<Query>::kCulls ? BvhWalk<Query>::kStack : 1];
-    BvhWalk<Query> w(box_ray, leaf_ray, q, root, word_stack, entry_stack);
+    BvhStacks<Query> stacks;
+    std::uint32_t word = root;
+    int size = 0;
     for (;;) {
-        const BvhStep s = bvh_step(nodes, leaves, w, c);
-        if (s == BvhStep::on) continue;
-        q = w.q;
-        return s == BvhStep::answered;
+        const BvhStep s = bvh_step(nodes, leaves, box_ray, leaf_ray, q, word, size, stacks.words, stacks.entries, c);
+        if (s != BvhStep::on) return s == BvhStep::answered;
     }
 }
 
@@ -319,74 +309,106 @@ void miss_all(std::span<const Ray> rays, std::span<Answer> out, TraversalCounter
     if (counters) counters->rays += rays.size();
 }
 
-// K rays' walks interleaved step by step on one thread. A random ray's steps wait on memory, each
+// Two rays' walks interleaved step by step on one thread. A random ray's steps wait on memory, each
 // node's address on the last node's bytes; one walk at a time keeps one such load in flight. With
-// the steps of K independent walks in turn, the core issues the next walk's load while the last
-// one's waits (and a load issued under a mispredicted branch still fetches its line), so up to K
-// misses overlap: the group prefetching of Chen, Ailamaki, Gibbons and Mowry, "Improving Hash Join
+// the steps of two independent walks in turn, the core issues one walk's load while the other's
+// waits (and a load issued under a mispredicted branch still fetches its line), so two misses
+// overlap: the group prefetching of Chen, Ailamaki, Gibbons and Mowry, "Improving Hash Join
 // Performance through Prefetching" (ICDE 2004), applied to traversal. Each walk is the single-ray
 // walk above, step for step, so the answers are its answers. `answer(i, query, step)` is called once
 // per ray of the batch: with a null query for an invalid ray (ray.hpp), which hits nothing.
-template <int K, class Query, class Counters, class Answer>
-void interleaved_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, Answer&& answer) {
-    using Walk = BvhWalk<Query>;
-    std::uint32_t word_stacks[K][Walk::kStack];
-    float entry_stacks[K][Walk::kCulls ? Walk::kStack : 1];
-    std::optional<Walk> walks[K];
-    std::size_t index[K];
-    std::size_t next = 0;
-    // Starts walk k on the batch's next valid ray, answering the invalid ones on the way; false when
-    // the batch has no ray left.
-    const auto start = [&](int k) {
-        for (; next < rays.size(); ++next) {
-            const Ray& ray = rays[next];
-            if (!is_valid(ray)) {
-                answer(next, static_cast<const Query*>(nullptr), BvhStep::done);
-                continue;
-            }
-            const TraversalRay r(ray, tree.bounds);
-            walks[k].emplace(BoxRay(r), LeafRay(r.watertight), Query(r), 0u, word_stacks[k], entry_stacks[k]);
-            index[k] = next++;
-            return true;
-        }
-        return false;
+template <class Query, class Counters, class Answer>
+void paired_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, Answer&& answer) {
+    constexpr std::size_t kNone = ~std::size_t{0};
+    // A walk's ray as the steps see it; its word and stack size are locals of the loop below.
+    struct Walk {
+        BoxRay box;
+        LeafRay leaf;
+        Query q;
     };
-    unsigned live = 0;
-    for (int k = 0; k < K; ++k)
-        if (start(k)) live |= 1u << k;
-    while (live) {
-#pragma GCC unroll 4
-        for (int k = 0; k < K; ++k) {
-            if (!(live >> k & 1)) continue;
-            const BvhStep s = bvh_step(tree.nodes.data(), tree.leaves.data(), *walks[k], c);
-            if (s == BvhStep::on) continue;
-            answer(index[k], &walks[k]->q, s);
-            if (!start(k)) live &= ~(1u << k);
+    const BvhNode* nodes = tree.nodes.data();
+    const BvhLeaf* leaves = tree.leaves.data();
+    BvhStacks<Query> stack_a, stack_b;
+    std::size_t next = 0;
+    // The batch's next valid ray, answering the invalid ones on the way; kNone when none is left.
+    const auto take = [&]() {
+        for (; next < rays.size(); ++next)
+            if (is_valid(rays[next])) return next++;
+            else answer(next, static_cast<const Query*>(nullptr), BvhStep::done);
+        return kNone;
+    };
+    const auto walk = [&](std::size_t i) {
+        const TraversalRay r(rays[i], tree.bounds);
+        return Walk{BoxRay(r), LeafRay(r.watertight), Query(r)};
+    };
+    const auto finish = [&](std::size_t i, Walk& w, std::uint32_t word, int size, BvhStacks<Query>& st) {
+        for (;;) {
+            const BvhStep s = bvh_step(nodes, leaves, w.box, w.leaf, w.q, word, size, st.words, st.entries, c);
+            if (s != BvhStep::on) return answer(i, &w.q, s);
+        }
+    };
+    std::size_t ia = take();
+    if (ia == kNone) return;
+    Walk a = walk(ia);
+    std::size_t ib = take();
+    if (ib == kNone) return finish(ia, a, 0u, 0, stack_a);
+    Walk b = walk(ib);
+    std::uint32_t word_a = 0, word_b = 0;
+    int size_a = 0, size_b = 0;
+    for (;;) {
+        BvhStep s = bvh_step(nodes, leaves, a.box, a.leaf, a.q, word_a, size_a, stack_a.words, stack_a.entries, c);
+        if (s != BvhStep::on) [[unlikely]] {
+            answer(ia, &a.q, s);
+            if ((ia = take()) == kNone) return finish(ib, b, word_b, size_b, stack_b);
+            a = walk(ia);
+            word_a = 0;
+            size_a = 0;
+        }
+        s = bvh_step(nodes, leaves, b.box, b.leaf, b.q, word_b, size_b, stack_b.words, stack_b.entries, c);
+        if (s != BvhStep::on) [[unlikely]] {
+            answer(ib, &b.q, s);
+            if ((ib = take()) == kNone) return finish(ia, a, word_a, size_a, stack_a);
+            b = walk(ib);
+            word_b = 0;
+            size_b = 0;
         }
     }
 }
 
-// The rays of a batch walked at once (interleaved_batch): measured per ray kind and scene in
-// docs/INCOHERENT.md, "Eleventh round".
-inline constexpr int kBvhWalks = 2;
-
-// The batch entry points: one kernel per query, over a batch, kBvhWalks rays at a time. The root's
-// box test is the scene box test, so rays are not clipped to the scene first.
+// The batch entry points: one kernel per query, over a batch. The root's box test is the scene box
+// test, so rays are not clipped to the scene first.
 inline void closest_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
                           TraversalCounters* counters) {
     if (tree.nodes.empty()) return miss_all(rays, hits, counters);
-    with_counters(counters, rays.size(), [&](auto& count) {
-        interleaved_batch<kBvhWalks, ClosestHit>(tree, rays, count, [&](std::size_t i, const ClosestHit* q, BvhStep) {
-            hits[i] = q ? q->result() : Hit{};
-        });
+    closest_hits(tree.bounds, rays, hits, counters, [&](const TraversalRay& r, ClosestHit& q, auto& count) {
+        return traverse_bvh_from(tree.nodes.data(), tree.leaves.data(), BoxRay(r), LeafRay(r.watertight), 0, q, count);
     });
 }
 
 inline void any_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                       TraversalCounters* counters) {
     if (tree.nodes.empty()) return miss_all(rays, occluded, counters);
+    any_hits(tree.bounds, rays, occluded, counters, [&](const TraversalRay& r, AnyHit& q, auto& count) {
+        return traverse_bvh_from(tree.nodes.data(), tree.leaves.data(), BoxRay(r), LeafRay(r.watertight), 0, q, count);
+    });
+}
+
+// The same, two rays at a time (paired_batch).
+inline void closest_paired_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
+                                 TraversalCounters* counters) {
+    if (tree.nodes.empty()) return miss_all(rays, hits, counters);
     with_counters(counters, rays.size(), [&](auto& count) {
-        interleaved_batch<kBvhWalks, AnyHit>(tree, rays, count, [&](std::size_t i, const AnyHit*, BvhStep s) {
+        paired_batch<ClosestHit>(tree, rays, count, [&](std::size_t i, const ClosestHit* q, BvhStep) {
+            hits[i] = q ? q->result() : Hit{};
+        });
+    });
+}
+
+inline void any_paired_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                             TraversalCounters* counters) {
+    if (tree.nodes.empty()) return miss_all(rays, occluded, counters);
+    with_counters(counters, rays.size(), [&](auto& count) {
+        paired_batch<AnyHit>(tree, rays, count, [&](std::size_t i, const AnyHit*, BvhStep s) {
             occluded[i] = s == BvhStep::answered ? 1 : 0;
         });
     });
@@ -407,6 +429,7 @@ inline void any_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std
 
 inline const BvhKernels& bvh_kernels(const char* isa) {
     static const BvhKernels k{&closest_batch,        &any_batch,        &closest_stream_batch, &any_stream_batch,
-                              &closest_packet_batch, &any_packet_batch, isa};
+                              &closest_packet_batch, &any_packet_batch, &closest_paired_batch, &any_paired_batch,
+                              isa};
     return k;
 }
