@@ -289,16 +289,54 @@ struct BvhStacks {
     float entries[Query::kAnyHit ? 1 : kBvhStackSize + kBvhStackSlack];
 };
 
+// A walk to its end from where it stands (`word`, with `size` children on `stacks`); true when an
+// any-hit query is answered.
+template <class Query, class Counters>
+[[gnu::always_inline]] inline bool traverse_bvh_from_walk(const BvhNode* nodes, const BvhLeaf* leaves,
+                                                          const BoxRay& box_ray, const LeafRay& leaf_ray, Query& q,
+                                                          std::uint32_t word, int size, BvhStacks<Query>& stacks,
+                                                          Counters& c) {
+    for (;;) {
+        const BvhStep s = bvh_step(nodes, leaves, box_ray, leaf_ray, q, word, size, stacks.words, stacks.entries, c);
+        if (s != BvhStep::on) return s == BvhStep::answered;
+    }
+}
+
 // One ray through the subtree of `root` (an inner node's word; 0 is the whole tree's root).
 template <class Query, class Counters>
 bool traverse_bvh_from(const BvhNode* nodes, const BvhLeaf* leaves, const BoxRay& box_ray, const LeafRay& leaf_ray,
                        std::uint32_t root, Query& q, Counters& c) {
     BvhStacks<Query> stacks;
-    std::uint32_t word = root;
-    int size = 0;
+    return traverse_bvh_from_walk(nodes, leaves, box_ray, leaf_ray, q, root, 0, stacks, c);
+}
+
+// Two rays from the subtree of `root`, their walks interleaved step by step (as paired_batch, below,
+// over a batch): the streams' leftover rays (bvh_stream.inl) go on this way. Sets `answered_a` and
+// `answered_b` for any-hit queries answered.
+template <class Query, class Counters>
+void traverse_two_from(const BvhNode* nodes, const BvhLeaf* leaves, std::uint32_t root, const BoxRay& box_a,
+                       const LeafRay& leaf_a, Query& q_a, bool& answered_a, const BoxRay& box_b, const LeafRay& leaf_b,
+                       Query& q_b, bool& answered_b, Counters& c) {
+    BvhStacks<Query> stack_a, stack_b;
+    std::uint32_t word_a = root, word_b = root;
+    int size_a = 0, size_b = 0;
     for (;;) {
-        const BvhStep s = bvh_step(nodes, leaves, box_ray, leaf_ray, q, word, size, stacks.words, stacks.entries, c);
-        if (s != BvhStep::on) return s == BvhStep::answered;
+        BvhStep s = bvh_step(nodes, leaves, box_a, leaf_a, q_a, word_a, size_a, stack_a.words, stack_a.entries, c);
+        if (s != BvhStep::on) [[unlikely]] {
+            answered_a = s == BvhStep::answered;
+            for (;;) {
+                s = bvh_step(nodes, leaves, box_b, leaf_b, q_b, word_b, size_b, stack_b.words, stack_b.entries, c);
+                if (s != BvhStep::on) break;
+            }
+            answered_b = s == BvhStep::answered;
+            return;
+        }
+        s = bvh_step(nodes, leaves, box_b, leaf_b, q_b, word_b, size_b, stack_b.words, stack_b.entries, c);
+        if (s != BvhStep::on) [[unlikely]] {
+            answered_b = s == BvhStep::answered;
+            answered_a = traverse_bvh_from_walk(nodes, leaves, box_a, leaf_a, q_a, word_a, size_a, stack_a, c);
+            return;
+        }
     }
 }
 

@@ -122,8 +122,9 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
             continue;
         }
         if (f.count <= kSingleBelow) {
-            // Too few rays left to share the node's lines: each goes on alone (the single-ray kernel,
-            // from this node), with the query it has carried so far.
+            // Too few rays left to share the node's lines: each goes on with its own walk from this
+            // node, with the query it has carried so far, two walks at a time (traverse_two_from).
+            std::uint32_t waiting = ~0u;  // a ray waiting for a second
             for (std::uint32_t j = f.begin; j < f.begin + f.count; ++j) {
                 const std::uint32_t k = arena[j].ray;
                 if constexpr (kAny) {
@@ -131,8 +132,20 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
                 } else {
                     if (arena[j].entry > queries[k].cull_t()) continue;
                 }
-                if (traverse_bvh_from(nodes, leaves, rays[k].box(), rays[k].leaf(), f.word, queries[k], c)) done[k] = 1;
+                if (waiting == ~0u) {
+                    waiting = k;
+                    continue;
+                }
+                bool answered_a = false, answered_b = false;
+                traverse_two_from(nodes, leaves, f.word, rays[waiting].box(), rays[waiting].leaf(), queries[waiting],
+                                  answered_a, rays[k].box(), rays[k].leaf(), queries[k], answered_b, c);
+                if (answered_a) done[waiting] = 1;
+                if (answered_b) done[k] = 1;
+                waiting = ~0u;
             }
+            if (waiting != ~0u &&
+                traverse_bvh_from(nodes, leaves, rays[waiting].box(), rays[waiting].leaf(), f.word, queries[waiting], c))
+                done[waiting] = 1;
             continue;
         }
         const BvhNode& node = nodes[f.word];
