@@ -27,7 +27,7 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
     if (kind_optional) kind.clear();
     cmd.add_option("--accel", kind, "Acceleration structure: " + kinds)->capture_default_str();
     cmd.add_option("--traversal", traversal,
-                   "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|stream|packet); "
+                   "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|paired|stream|packet); "
                    "implies --simd off");
     simd_option = cmd.add_option("--simd", simd,
                                  "SIMD ray packets: auto|off|portable|sse|avx2|avx512 (docs/PACKETS.md)")
