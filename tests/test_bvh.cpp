@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -204,7 +205,7 @@ TEST(Bvh, SpatialSplitsCoverEveryTriangleWithinTheBudget) {
                     EXPECT_GT(tree.references, tris.size() * 11 / 10);
                     EXPECT_LT(tree.sah_cost, 0.9 * detail::build_bvh(tris, without_spatial_splits(max_leaf)).sah_cost);
                 }
-                for (const char* traversal : {"wide", "stream", "packet"}) {
+                for (const char* traversal : {"wide", "paired", "stream", "packet"}) {
                     AccelConfig c = bvh({{"split_budget", std::to_string(budget)}, {"max_leaf", std::to_string(max_leaf)}});
                     c.traversal = traversal;
                     test::expect_matches(*make_accelerator(tris, c), ref, what + " " + traversal);
@@ -378,18 +379,17 @@ TEST(Bvh, RaysAlongItsOwnBoxFaces) {
     }
     const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
     test::expect_matches(*make_accelerator(scene.triangles, bvh()), ref, "bvh on its box faces");
-    for (const char* config : {"bvh:stream", "bvh:packet"})
+    for (const char* config : {"bvh:paired", "bvh:stream", "bvh:packet"})
         test::expect_matches(*make_accelerator(scene.triangles, parse_accel_config(config)), ref,
                              std::string(config) + " on its box faces");
 }
 
-// The stream and packet traversals on batches of every size, from one ray to the whole suite in one
-// call (the per-thread scratch grows and is reused; packets of eight rays and a short last one), with
-// invalid rays mixed in: the brute-force answers, and every ray counted once.
-// Every traversal in batches of any size, invalid rays among them, on every instruction set. The
-// paired traversal walks two rays of a batch at once (paired_batch), each the single-ray walk step
-// for step, so its work per ray is the single-ray kernel's whatever the batch (a batch of one walks
-// alone, and a batch's last ray may walk alone too).
+// Every traversal in batches of every size, from one ray to the whole suite in one call (the
+// streams' per-thread scratch grows and is reused; packets of eight rays and a short last one), with
+// invalid rays mixed in, on every instruction set: the brute-force answers, and every ray counted
+// once. The paired traversal walks two rays of a batch at once (paired_batch), each the single-ray
+// walk step for step, so its work per ray is the single-ray kernel's whatever the batch (a batch of
+// one walks alone, and a batch's last ray may walk alone too).
 TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& suite = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
@@ -499,6 +499,33 @@ TEST(Bvh, EmptySceneMissesEverything) {
     for (std::uint8_t o : occluded) EXPECT_EQ(o, 0);
     EXPECT_EQ(counters.rays, rays.size());
     EXPECT_EQ(accel->stats().memory_bytes, 0u);
+}
+
+// Batches with nothing to walk, on every traversal: empty, and every ray invalid (a zero direction,
+// a NaN origin, tnear past tfar): each answered as a miss, not occluded, and counted.
+TEST(Bvh, BatchesOfOnlyInvalidRaysOrNoneAnswerMisses) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
+    std::vector<Ray> rays(5);
+    for (Ray& r : rays) r.dir = {0.f, 0.f, 1.f};
+    rays[0].dir = {0.f, 0.f, 0.f};
+    rays[1].org.x = std::nanf("");
+    rays[2].tnear = 2.f, rays[2].tfar = 1.f;
+    rays[3].dir = {0.f, 0.f, 0.f};
+    rays[4].dir.y = std::numeric_limits<float>::infinity();
+    for (const char* traversal : {"wide", "paired", "stream", "packet"}) {
+        const auto accel = make_accelerator(scene.triangles, parse_accel_config(std::string("bvh:") + traversal));
+        TraversalCounters counters;
+        accel->intersect({}, {}, &counters);
+        accel->occluded({}, {}, &counters);
+        EXPECT_EQ(counters.rays, 0u) << traversal;
+        std::vector<Hit> hits(rays.size(), Hit{1.f, 7, 0.f, 0.f});
+        std::vector<std::uint8_t> occluded(rays.size(), 1);
+        accel->intersect(rays, hits, &counters);
+        accel->occluded(rays, occluded, &counters);
+        for (const Hit& h : hits) EXPECT_FALSE(h.is_hit()) << traversal;
+        for (std::uint8_t o : occluded) EXPECT_EQ(o, 0) << traversal;
+        EXPECT_EQ(counters.rays, 2 * rays.size()) << traversal;
+    }
 }
 
 TEST(Bvh, RefusesBadParameters) {

@@ -24,15 +24,15 @@ namespace cellrt {
 namespace {
 
 // Every exact structure path: KIND:TRAVERSAL for single rays, KIND+SIMD for the packet kernels of
-// each instruction set this machine runs (for the wide BVH, its single-ray, stream and packet kernels of
-// that set); and the BIH built with the SAH, by both.
+// each instruction set this machine runs (for the wide BVH, its single-ray, paired, stream and packet kernels
+// of that set); and the BIH built with the SAH, by both.
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
                                     "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih",
-                                    "auto@packets=bih-sah", "auto@route=coherence", "auto@streams=off", "bvh:stream",
-                                    "bvh:packet"};
+                                    "auto@packets=bih-sah", "auto@route=coherence", "auto@streams=off", "bvh:paired",
+                                    "bvh:stream", "bvh:packet"};
     for (detail::Isa isa : detail::available_isas())
-        for (const char* kind : {"kd", "bih", "bvh", "bvh:stream", "bvh:packet"})
+        for (const char* kind : {"kd", "bih", "bvh", "bvh:paired", "bvh:stream", "bvh:packet"})
             out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;
 }

@@ -1,7 +1,7 @@
 // `--accel auto`: cellrt's fastest exact path for a mix of coherent and incoherent batches. It holds
 // two exact structures, SIMD packets over a study tree (fastest on coherent batches: a frame's primary
 // rays, shadow rays toward one light) and the wide BVH (fastest on incoherent ones: diffuse bounces,
-// AO, random queries), the latter traced one ray at a time, as a stream (unless streams=off;
+// AO, random queries), the latter traced as single rays two at a time (bvh:paired), as a stream (unless streams=off;
 // bvh_stream.inl: the batch's rays down the tree together) or in packets of eight rays (unless
 // bvh_packets=off; bvh_packet.inl), and routes each batch by its coherence
 // and by the time per ray each path has taken on batches of its kind (docs/BVH.md, docs/INCOHERENT.md).

@@ -324,11 +324,7 @@ void traverse_two_from(const BvhNode* nodes, const BvhLeaf* leaves, std::uint32_
         BvhStep s = bvh_step(nodes, leaves, box_a, leaf_a, q_a, word_a, size_a, stack_a.words, stack_a.entries, c);
         if (s != BvhStep::on) [[unlikely]] {
             answered_a = s == BvhStep::answered;
-            for (;;) {
-                s = bvh_step(nodes, leaves, box_b, leaf_b, q_b, word_b, size_b, stack_b.words, stack_b.entries, c);
-                if (s != BvhStep::on) break;
-            }
-            answered_b = s == BvhStep::answered;
+            answered_b = traverse_bvh_from_walk(nodes, leaves, box_b, leaf_b, q_b, word_b, size_b, stack_b, c);
             return;
         }
         s = bvh_step(nodes, leaves, box_b, leaf_b, q_b, word_b, size_b, stack_b.words, stack_b.entries, c);

@@ -11,7 +11,8 @@
 // single-ray kernel skips a popped child. An any-hit ray leaves every stream once it is answered.
 //
 // A stream of a few rays (kSingleBelow) goes on as single rays from the node it reached, each with
-// the query it carries, as Embree's hybrid packets fall back to single rays when few lanes are left.
+// the query it carries, as Embree's hybrid packets fall back to single rays when few lanes are left;
+// two walks at a time (traverse_two_from).
 //
 // The tests are bvh_kernels.inl's, lane for lane, and every ray ends with the hit rule's answer among
 // the triangles of the leaves it reached; a leaf is skipped only when the single-ray kernel would skip
@@ -20,8 +21,8 @@
 //
 // No include guard: included after bvh_kernels.inl in each instruction set's namespace.
 
-// A stream of at most this many rays goes on as single rays (bvh_kernels.inl) from the node it
-// reached: below it the stream's bookkeeping costs more than the node's shared lines save (Sponza,
+// A stream of at most this many rays goes on as single rays, two walks at a time (bvh_kernels.inl),
+// from the node it reached: below it the stream's bookkeeping costs more than the node's shared lines save (Sponza,
 // 2026-12-02, docs/INCOHERENT.md "Ray streams": 0 to 4 lose on diffuse bounces, 8 and 16 win on AO).
 inline constexpr std::uint32_t kSingleBelow = 8;
 
