@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Issue 18's figures from run.sh's files: per ray kind and scene, each config's time (primary +
-shadow seconds) over Embree's fastest (the lesser of embree:single and embree:packet8) in the same
+shadow seconds; the configs the files hold) over Embree's fastest (the lesser of embree:single and embree:packet8) in the same
 run, as speed ratios (Embree's time / config's time); the median of the runs, and their range."""
 import json, glob, statistics, sys
 kinds = ['frame', 'ao', 'diffuse', 'random']
-configs = ['auto', 'bvh', 'bvh:packet', 'kd:rec', 'kd:branched']
+# The configs of the first run, in its order, but Embree's (the ones divided by).
+first = json.load(open(sorted(glob.glob('state_frame_*.json'))[0]))
+configs = list(dict.fromkeys(r['config'] for r in first if not r['config'].startswith('embree')))
 print('| rays | scene | ' + ' | '.join(f'`{c}`' for c in configs) + ' | kd:rec primary ÷ rtcIntersect1 |')
 print('|---|---|' + '--:|' * (len(configs) + 1))
 for kind in kinds:
