@@ -63,6 +63,15 @@ def test_single_ray_traversals(case):
         assert_same_hits(cellrt.Accelerator(scene.triangles, kind=kind, simd="off").intersect(*rays), hits)
 
 
+def test_bvh_traversals(case):
+    scene, rays, hits, occluded = case
+    for kind in ("bvh:wide", "bvh:paired", "bvh:stream", "bvh:packet"):
+        acc = cellrt.Accelerator(scene.triangles, kind=kind)
+        assert acc.stats.traversal == kind.split(":")[1]
+        assert_same_hits(acc.intersect(*rays), hits)
+        assert np.array_equal(acc.occluded(*rays), occluded)
+
+
 def test_indexed_mesh_equals_triangle_soup(city):
     tris = np.asarray(city.triangles)
     vertices, faces = np.unique(tris.reshape(-1, 3), axis=0, return_inverse=True)
