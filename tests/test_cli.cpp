@@ -104,6 +104,8 @@ TEST(Cli, SameImageForEveryPath) {
             {"kd_portable", {"--accel", "kd", "--simd", "portable", "--packet", "7"}},
             {"brute_auto", {"--accel", "brute", "--packet", "8"}},
             {"bvh", {"--accel", "bvh", "--packet", "4"}},
+            {"bvh_paired", {"--accel", "bvh", "--traversal", "paired", "--threads", "2", "--packet", "3"}},
+            {"bvh_stream", {"--accel", "bvh", "--traversal", "stream", "--packet", "16"}},
             {"routed", {"--accel", "auto", "--threads", "2"}},
         };
         for (const auto& [name, extra] : paths) {
