@@ -375,11 +375,10 @@ void paired_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, A
         const TraversalRay r(rays[i], tree.bounds);
         return Walk{BoxRay(r), LeafRay(r.watertight), Query(r)};
     };
+    // The walk left when the batch runs out goes on alone.
     const auto finish = [&](std::size_t i, Walk& w, std::uint32_t word, int size, BvhStacks<Query>& st) {
-        for (;;) {
-            const BvhStep s = bvh_step(nodes, leaves, w.box, w.leaf, w.q, word, size, st.words, st.entries, c);
-            if (s != BvhStep::on) return answer(i, &w.q, s);
-        }
+        const bool answered = traverse_bvh_from_walk(nodes, leaves, w.box, w.leaf, w.q, word, size, st, c);
+        answer(i, &w.q, answered ? BvhStep::answered : BvhStep::done);
     };
     std::size_t ia = take();
     if (ia == kNone) return;
