@@ -9,15 +9,40 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
 #include "cellrt/loaders.hpp"
+#include "scene/read_file.hpp"
 
 namespace cellrt {
 namespace {
+
+// The files tinygltf reads (the .gltf or .glb itself and external buffers), read by cellrt's own
+// reader: tinygltf's takes a folder's size as 2^63 - 1 bytes and allocates it (a buffer whose uri
+// names a folder; found by fuzz_gltf). Only a regular, non-empty file is read.
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        if (err) *err += path + ": not a regular file\n";
+        return false;
+    }
+    try {
+        const std::string bytes = detail::read_file(path);
+        out->assign(bytes.begin(), bytes.end());
+    } catch (const Error& e) {
+        if (err) *err += std::string(e.what()) + "\n";
+        return false;
+    }
+    if (out->empty()) {
+        if (err) *err += path + ": the file is empty\n";
+        return false;
+    }
+    return true;
+}
 
 // Column-major 4x4, as glTF writes matrices; double so that a chain of transforms rounds once.
 using Matrix = std::array<double, 16>;
@@ -110,6 +135,8 @@ private:
         loader.SetImageLoader([](tinygltf::Image*, int, std::string*, std::string*, int, int, const unsigned char*,
                                  int, void*) { return true; },
                               nullptr);
+        loader.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_whole_file,
+                               &tinygltf::WriteWholeFile, nullptr});
         std::string err, warn;
         const std::string ext = lower_extension(path_);
         bool ok = false;
