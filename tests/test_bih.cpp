@@ -135,6 +135,46 @@ TEST(Bih, RootBoundsKeepTheFirstOfEqualZerosAtAnyThreadCount) {
     }
 }
 
+// A range partitioned on several threads bounds each side as one ascending pass over its final order
+// does: where +0 and -0 both bound the right side, its clip plane keeps the one met first, as the
+// one-thread partition's. Two clusters of 20,000 triangles, split at the root between them; the right
+// one's lowest x is a zero, given to one triangle as +0 and to another as -0: triangles 2001 (moved
+// by the partition to 37,998) and 31001, in different blocks of the partition's passes, or 30001 and
+// 30003, in the same block.
+TEST(Bih, PartitionOnSeveralThreadsKeepsTheFirstOfEqualZeros) {
+    for (const auto& [first, second] : {std::pair{2001, 31001}, std::pair{30001, 30003}}) {
+        for (const bool plus_first : {true, false}) {
+            std::vector<Triangle> tris;
+            for (int i = 0; i < 40000; ++i) {
+                const float x = (i % 2 == 1 ? 1.f : -300.f) + static_cast<float>(i / 2 % 100);
+                const float y = static_cast<float>(i / 200);
+                tris.push_back({{x, y, 1.f}, {x + 1.f, y, 1.f}, {x, y + 1.f, 2.f}});
+            }
+            tris[first].v0.x = plus_first ? 0.f : -0.f;
+            tris[second].v0.x = plus_first ? -0.f : 0.f;
+            detail::BihBuildParams p;
+            p.split = detail::BihSplit::sah;
+            p.threads = 1;
+            const detail::BihTree one = detail::build_bih(tris, p);
+            ASSERT_FALSE(one.nodes[0].is_leaf());
+            ASSERT_EQ(one.nodes[0].axis(), 0);
+            ASSERT_EQ(one.nodes[0].clip(1), 0.f);
+            p.parallel_pass_min = 4096;
+            for (unsigned threads : {2u, 4u}) {
+                p.threads = threads;
+                const detail::BihTree many = detail::build_bih(tris, p);
+                const std::string what = std::to_string(first) + " and " + std::to_string(second) + ", " +
+                                         std::to_string(threads) + " threads";
+                EXPECT_EQ(std::signbit(many.nodes[0].clip(1)), std::signbit(one.nodes[0].clip(1))) << what;
+                ASSERT_EQ(one.nodes.size(), many.nodes.size()) << what;
+                EXPECT_EQ(std::memcmp(one.nodes.data(), many.nodes.data(), one.nodes.size() * sizeof(detail::BihNode)), 0)
+                    << what;
+                EXPECT_EQ(one.prims, many.prims) << what;
+            }
+        }
+    }
+}
+
 // The SAH build is a better hierarchy by its own measure: a lower SAH cost in the build report than
 // the global heuristic's on a scene of uneven density.
 TEST(Bih, SahSplitLowersTheSahCost) {

@@ -46,9 +46,11 @@ namespace cellrt::detail {
 namespace {
 
 constexpr std::size_t kParallelMin = 4096;
-// Ranges binned by several threads (BihBuildParams::parallel_pass_min), and the passes over all
-// triangles of a parallel build, are cut in blocks of this many.
+// The passes over all triangles of a parallel build are cut in blocks of this many, and the passes
+// over a range on several threads (binning and partition, BihBuildParams::parallel_pass_min) in
+// blocks of kRangeBlock.
 constexpr std::size_t kBlock = 16384;
+constexpr std::size_t kRangeBlock = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The SAH's bins per axis (its costs and largest leaf are parameters: BihBuildParams).
@@ -258,12 +260,12 @@ private:
         });
     }
 
-    // Calls body(begin, end) for [0, n) in blocks of kBlock: on several threads in a parallel build
+    // Calls body(begin, end) for [0, n) in blocks of `size`: on several threads in a parallel build
     // (within its arena), in order on one. No block's work may depend on another's.
     template <class Body>
-    void for_blocks(std::size_t n, Body&& body) const {
-        const std::size_t count = (n + kBlock - 1) / kBlock;
-        auto block = [&](std::size_t b) { body(b * kBlock, std::min(n, (b + 1) * kBlock)); };
+    void for_blocks(std::size_t n, Body&& body, std::size_t size = kBlock) const {
+        const std::size_t count = (n + size - 1) / size;
+        auto block = [&](std::size_t b) { body(b * size, std::min(n, (b + 1) * size)); };
         if (p_.threads == 1 || count < 2) {
             for (std::size_t b = 0; b < count; ++b) block(b);
             return;
@@ -310,15 +312,36 @@ private:
     }
 
     // Partitions the range in place into the triangles for which `goes_left` holds and the rest (both
-    // sides non-empty), with the clip planes at the two sides' extents on `a`, and bounds each side in
-    // the same pass. The partition is Hoare's (Quicksort, 1962), step for step libstdc++'s
-    // std::partition (which main's builder called), so the order and the tree are unchanged. Left
-    // triangles are met in ascending final position and right ones in descending: the right side's
-    // bounds take equal values (+0 and -0) from the lower position, as a scan in ascending order does,
-    // so the planes' bits are the same.
+    // sides non-empty), with the clip planes at the two sides' extents on `a`, and each side's bounds.
     template <class GoesLeft>
     Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
         Bounds left, right;
+        const std::uint32_t mid = p_.threads != 1 && r.size() >= p_.parallel_pass_min
+                                      ? partition_in_blocks(r, goes_left, left, right)
+                                      : partition(r, goes_left, left, right);
+        Decision d;
+        d.kind = Kind::split;
+        d.axis = a;
+        d.left = d.right = r;
+        d.left.end = mid;
+        d.right.begin = mid;
+        left.store(d.left);
+        right.store(d.right);
+        d.left_clip = d.left.objects.hi[a];
+        d.right_clip = d.right.objects.lo[a];
+        d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
+        d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
+        d.left.depth = d.right.depth = r.depth + 1;
+        return d;
+    }
+
+    // Hoare's partition (Quicksort, 1962), step for step libstdc++'s std::partition (which the first
+    // builder called), bounding each side in the same pass; returns the first right position. Left
+    // triangles are met in ascending final position and right ones in descending: the right side's
+    // bounds take equal values (+0 and -0) from the lower position, as a scan in ascending order does,
+    // so the planes' bits are those of one ascending pass over each side.
+    template <class GoesLeft>
+    std::uint32_t partition(const Range& r, GoesLeft& goes_left, Bounds& left, Bounds& right) {
         Item* first = items_.data() + r.begin;
         Item* last = items_.data() + r.end;
         for (;;) {
@@ -335,21 +358,87 @@ private:
             right.take<Order::descending>(*last);
             ++first;
         }
-        const auto mid = static_cast<std::uint32_t>(first - items_.data());
-        Decision d;
-        d.kind = Kind::split;
-        d.axis = a;
-        d.left = d.right = r;
-        d.left.end = mid;
-        d.right.begin = mid;
-        left.store(d.left);
-        right.store(d.right);
-        d.left_clip = d.left.objects.hi[a];
-        d.right_clip = d.right.objects.lo[a];
-        d.left.box.hi[a] = std::min(d.left.box.hi[a], d.left_clip);
-        d.right.box.lo[a] = std::max(d.right.box.lo[a], d.right_clip);
-        d.left.depth = d.right.depth = r.depth + 1;
-        return d;
+        return static_cast<std::uint32_t>(first - items_.data());
+    }
+
+    // The same order and bounds on several threads. Hoare's loop swaps the j-th right-goer met from
+    // the left with the j-th left-goer met from the right, and every one of those lies left of `mid`
+    // (the number of left-goers) and right of it respectively; the rest stay. So: count each block's
+    // left-goers (their flags kept), rank the misplaced triangles by those counts, note where each
+    // rank's left-goer lies, swap the pairs (all independent), and bound the two sides block by block,
+    // combined in block order as one ascending pass would. Hence the tree is the same at any thread
+    // count (Bih.SameHierarchyBytesAtAnyThreadCount lowers parallel_pass_min to reach this).
+    template <class GoesLeft>
+    std::uint32_t partition_in_blocks(const Range& r, GoesLeft& goes_left, Bounds& left, Bounds& right) {
+        Item* items = items_.data() + r.begin;
+        const std::size_t n = r.size(), blocks = (n + kRangeBlock - 1) / kRangeBlock;
+        const auto block_end = [&](std::size_t b) { return std::min(n, (b + 1) * kRangeBlock); };
+        std::vector<std::uint8_t> goes(n);
+        std::vector<std::size_t> lefts(blocks);
+        for_blocks(
+            n,
+            [&](std::size_t begin, std::size_t end) {
+                std::size_t count = 0;
+                for (std::size_t i = begin; i < end; ++i) count += goes[i] = goes_left(items[i]) ? 1 : 0;
+                lefts[begin / kRangeBlock] = count;
+            },
+            kRangeBlock);
+        std::size_t mid = 0;
+        for (std::size_t c : lefts) mid += c;
+        // Per block: the rank of its first misplaced triangle: right-goers left of mid counted from the
+        // left, left-goers from mid on counted from the right.
+        std::vector<std::size_t> low_rank(blocks), high_rank(blocks);
+        std::size_t misplaced = 0;
+        for (std::size_t b = 0; b < blocks; ++b) {
+            low_rank[b] = misplaced;
+            const std::size_t begin = b * kRangeBlock, end = std::min(block_end(b), mid);
+            if (begin >= end) continue;
+            if (end == block_end(b)) misplaced += (end - begin) - lefts[b];
+            else
+                for (std::size_t i = begin; i < end; ++i) misplaced += goes[i] ^ 1u;
+        }
+        std::size_t seen = 0;
+        for (std::size_t b = blocks; b-- > 0;) {
+            high_rank[b] = seen;
+            const std::size_t begin = std::max(b * kRangeBlock, mid), end = block_end(b);
+            if (begin >= end) continue;
+            if (begin == b * kRangeBlock) seen += lefts[b];
+            else
+                for (std::size_t i = begin; i < end; ++i) seen += goes[i];
+        }
+        std::vector<std::size_t> partner(misplaced);
+        for_blocks(
+            n,
+            [&](std::size_t begin, std::size_t end) {
+                std::size_t rank = high_rank[begin / kRangeBlock];
+                for (std::size_t i = end; i-- > std::max(begin, mid);)
+                    if (goes[i]) partner[rank++] = i;
+            },
+            kRangeBlock);
+        for_blocks(
+            n,
+            [&](std::size_t begin, std::size_t end) {
+                std::size_t rank = low_rank[begin / kRangeBlock];
+                for (std::size_t i = begin; i < std::min(end, mid); ++i)
+                    if (!goes[i]) std::swap(items[i], items[partner[rank++]]);
+            },
+            kRangeBlock);
+        std::vector<Bounds> left_blocks(blocks), right_blocks(blocks);
+        for_blocks(
+            n,
+            [&](std::size_t begin, std::size_t end) {
+                Bounds &l = left_blocks[begin / kRangeBlock], &rt = right_blocks[begin / kRangeBlock];
+                for (std::size_t i = begin; i < end; ++i) {
+                    if (i < mid) l.take<Order::ascending>(items[i]);
+                    else rt.take<Order::ascending>(items[i]);
+                }
+            },
+            kRangeBlock);
+        for (std::size_t b = 0; b < blocks; ++b) {
+            left.merge(left_blocks[b]);
+            right.merge(right_blocks[b]);
+        }
+        return r.begin + static_cast<std::uint32_t>(mid);
     }
 
     // The SAH split (see the top of this file).
@@ -426,7 +515,7 @@ private:
     }
 
     // The range's bins. In parallel builds a range of parallel_pass_min triangles or more is binned by
-    // several threads, in blocks of kBlock combined in block order: the bins of one pass.
+    // several threads, in blocks of kRangeBlock combined in block order: the bins of one pass.
     Bins bin(const Range& r, F4 origin, F4 scale) const {
         const std::span<const Item> items(items_.data() + r.begin, r.size());
         Bins bins;
@@ -434,10 +523,13 @@ private:
             bins.add(items, origin, scale);
             return bins;
         }
-        std::vector<Bins> blocks((items.size() + kBlock - 1) / kBlock);
-        for_blocks(items.size(), [&](std::size_t begin, std::size_t end) {
-            blocks[begin / kBlock].add(items.subspan(begin, end - begin), origin, scale);
-        });
+        std::vector<Bins> blocks((items.size() + kRangeBlock - 1) / kRangeBlock);
+        for_blocks(
+            items.size(),
+            [&](std::size_t begin, std::size_t end) {
+                blocks[begin / kRangeBlock].add(items.subspan(begin, end - begin), origin, scale);
+            },
+            kRangeBlock);
         for (const Bins& block : blocks) bins.append(block);
         return bins;
     }
