@@ -6,8 +6,9 @@
 //  - "before" (bb00eca^): an empty-space cut (one child an empty leaf) kept its whole subtree in its
 //    parent's task; nodes of 65,536 triangles or more were binned on all threads (span n / 2 + n / 32);
 //  - "cuts" (bb00eca): the cut's occupied child is a task of its own;
-//  - "blocks P": also the partition on all threads, binning and partition from P triangles on
-//    (parallel_pass_min; span n / 16).
+//  - "blocks" (this change): also the partition on all threads; a node's passes run on all threads
+//    from 16,384 triangles on (parallel_pass_min) when it holds more than the scene's triangles over
+//    the threads (span n / 16), else on one.
 // Work / span bounds the speed-up on 16 threads (and on any number).
 //   g++ -I include -I src -O2 -std=c++20 docs/figures/bih_span.cpp build/libcellrt.a -ltbb -lembree3 -o bih_span
 //   ./bih_span SCENE...
@@ -38,7 +39,7 @@ struct Walk {
         return triangles(i) + work(n.children()) + work(n.children() + 1);
     }
     // {work, span} of the subtree at node i; `blocks`: the smallest node whose passes are all parallel
-    // (0: only the binning of nodes from 65,536 on).
+    // (0: only the binning of nodes from 65,536 on, the builders before).
     std::pair<double, double> span(std::uint32_t i, bool cuts_as_tasks, double blocks) const {
         const detail::BihNode& n = tree.nodes[i];
         const double size = triangles(i);
@@ -56,8 +57,8 @@ struct Walk {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::printf("| scene | triangles | work | before | cuts | blocks 65,536 | blocks 16,384 | blocks 8,192 |\n");
-    std::printf("|---|--:|--:|--:|--:|--:|--:|--:|\n");
+    std::printf("| scene | triangles | work | before | cuts | blocks |\n");
+    std::printf("|---|--:|--:|--:|--:|--:|\n");
     for (int i = 1; i < argc; ++i) {
         const Scene scene = load_scene(argv[i]);
         detail::BihBuildParams p;
@@ -67,7 +68,8 @@ int main(int argc, char** argv) {
         const Walk walk{tree};
         const double work = walk.work(0);
         std::printf("| %s | %zu | %.0f", argv[i], scene.triangles.size(), work);
-        const std::pair<bool, double> builders[] = {{false, 0}, {true, 0}, {true, 65536}, {true, 16384}, {true, 8192}};
+        const double blocks = std::max(16384.0, static_cast<double>(scene.triangles.size() / 16 + 1));
+        const std::pair<bool, double> builders[] = {{false, 0}, {true, 0}, {true, blocks}};
         for (const auto& [cuts, blocks] : builders) std::printf(" | %.2f", work / walk.span(0, cuts, blocks).second);
         std::printf(" |\n");
     }

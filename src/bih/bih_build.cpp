@@ -47,8 +47,8 @@ namespace {
 
 constexpr std::size_t kParallelMin = 4096;
 // The passes over all triangles of a parallel build are cut in blocks of this many, and the passes
-// over a range on several threads (binning and partition, BihBuildParams::parallel_pass_min) in
-// blocks of kRangeBlock.
+// over a range on several threads (binning and partition, range_pass_min_ below) in blocks of
+// kRangeBlock.
 constexpr std::size_t kBlock = 16384;
 constexpr std::size_t kRangeBlock = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -216,6 +216,8 @@ private:
     void build_into(BihTree& tree) {
         const std::size_t n = tris_.size();
         items_.resize(n);
+        if (p_.threads != 1)
+            range_pass_min_ = std::max(p_.parallel_pass_min, n / static_cast<std::size_t>(build_concurrency(p_.threads)) + 1);
         std::vector<Bounds> blocks((n + kBlock - 1) / kBlock);
         for_blocks(n, [&](std::size_t begin, std::size_t end) {
             Bounds& b = blocks[begin / kBlock];
@@ -316,9 +318,8 @@ private:
     template <class GoesLeft>
     Decision split_at(const Range& r, int a, GoesLeft&& goes_left) {
         Bounds left, right;
-        const std::uint32_t mid = p_.threads != 1 && r.size() >= p_.parallel_pass_min
-                                      ? partition_in_blocks(r, goes_left, left, right)
-                                      : partition(r, goes_left, left, right);
+        const std::uint32_t mid = r.size() >= range_pass_min_ ? partition_in_blocks(r, goes_left, left, right)
+                                                              : partition(r, goes_left, left, right);
         Decision d;
         d.kind = Kind::split;
         d.axis = a;
@@ -367,7 +368,7 @@ private:
     // left-goers (their flags kept), rank the misplaced triangles by those counts, note where each
     // rank's left-goer lies, swap the pairs (all independent), and bound the two sides block by block,
     // combined in block order as one ascending pass would. Hence the tree is the same at any thread
-    // count (Bih.SameHierarchyBytesAtAnyThreadCount lowers parallel_pass_min to reach this).
+    // count (Bih.SameHierarchyBytesAtAnyThreadCount and Bih.PartitionOnSeveralThreadsKeepsTheFirstOfEqualZeros).
     template <class GoesLeft>
     std::uint32_t partition_in_blocks(const Range& r, GoesLeft& goes_left, Bounds& left, Bounds& right) {
         Item* items = items_.data() + r.begin;
@@ -514,12 +515,12 @@ private:
         return split_at(r, best_axis, [&](const Item& t) { return bins_of(lanes_centre(t), origin, scale)[best_axis] <= best_bin; });
     }
 
-    // The range's bins. In parallel builds a range of parallel_pass_min triangles or more is binned by
-    // several threads, in blocks of kRangeBlock combined in block order: the bins of one pass.
+    // The range's bins. A range of range_pass_min_ triangles or more is binned by several threads, in
+    // blocks of kRangeBlock combined in block order: the bins of one pass.
     Bins bin(const Range& r, F4 origin, F4 scale) const {
         const std::span<const Item> items(items_.data() + r.begin, r.size());
         Bins bins;
-        if (p_.threads == 1 || r.size() < p_.parallel_pass_min) {
+        if (r.size() < range_pass_min_) {
             bins.add(items, origin, scale);
             return bins;
         }
@@ -603,6 +604,12 @@ private:
 
     std::span<const Triangle> tris_;
     const BihBuildParams& p_;
+    // The smallest range whose passes run on several threads: in a parallel build, one of more than
+    // its share of the triangles (n / threads: above it the build's tasks are fewer than its threads,
+    // and a range's partition would hold the others up), and of parallel_pass_min at least. Smaller
+    // ranges run their passes on one thread, which is less work (the partition in blocks takes four
+    // passes over its range, Hoare's one).
+    std::size_t range_pass_min_ = std::numeric_limits<std::size_t>::max();
     std::vector<Item> items_;
 };
 

@@ -41,9 +41,10 @@ struct BihBuildParams {
     double intersection_cost = 20.0;
     int sah_max_leaf = 16;
     unsigned threads = 0;  // 0: all hardware threads; the hierarchy is the same for every value
-    // Parallel builds: nodes with at least this many triangles are partitioned (and with split=sah
-    // binned) by several threads, the nodes near the root that would otherwise hold the others up
-    // (not a `-P` parameter: a test lowers it to check that the hierarchy stays the same).
+    // Parallel builds: nodes with at least this many triangles, and more than the scene's triangles
+    // over the threads, are partitioned (and with split=sah binned) by several threads: the nodes near
+    // the root, which would otherwise hold the others up (not a `-P` parameter: a test lowers it to
+    // check that the hierarchy stays the same).
     std::size_t parallel_pass_min = 16384;
 };
 
