@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -93,6 +96,65 @@ TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
     EXPECT_THROW(write_image(img, (dir / "no" / "such" / "x.png").string(), false), Error);
     EXPECT_THROW(write_image(img, (dir / "x.bmp").string(), false), Error);
     std::filesystem::remove_all(dir);
+}
+
+// A PNG from the frame's 8-bit pixels (what cellrt-mpi's ranks send) is the PNG of its floats, byte for
+// byte; each byte is the channel's sRGB value, scaled and rounded, clamped at 0 and 1.
+TEST(Render, PngOfEightBitPixelsIsThePngOfTheFloats) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=400");
+    Image img = render_with(scene, "brute", 2, 20, 10);
+    img.at(0, 0) = Vec3(-1.f, 2.f, 0.5f);
+    const Srgb8Image bytes = to_srgb8(img);
+    ASSERT_EQ(bytes.rgb.size(), 3u * 20 * 10);
+    EXPECT_EQ(bytes.rgb[0], 0);
+    EXPECT_EQ(bytes.rgb[1], 255);
+    EXPECT_EQ(bytes.rgb[2], 188);  // 255 * (1.055 * 0.5^(1/2.4) - 0.055) = 187.5...
+    EXPECT_EQ(bytes.rgb[3 * 13 + 1], srgb8(img.pixels[13].y));
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_png_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string floats = (dir / "floats.png").string(), eight = (dir / "eight.png").string();
+    write_image(img, floats, false);
+    write_png(bytes, eight, false);
+    auto read = [](const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_FALSE(read(floats).empty());
+    EXPECT_EQ(read(eight), read(floats));
+    EXPECT_EQ(test::error_of([&] { write_png(bytes, eight, false); }), eight + ": file exists and overwrite is off");
+    EXPECT_EQ(test::error_of([&] { write_png(bytes, (dir / "x.pfm").string(), false); }),
+              (dir / "x.pfm").string() + ": 8-bit pixels are written as .png only");
+    std::filesystem::remove_all(dir);
+}
+
+// The table gives the formula's byte (every float of [0, 1] is checked by docs/figures/srgb8_check.cpp;
+// here the ends, the values outside [0, 1], a million floats of it at random and the floats next to
+// each byte's first).
+TEST(Render, Srgb8TableGivesTheFormulasBytes) {
+    for (const float x : {0.f, -0.f, 1.f, -1.f, 2.f, 1e30f, -1e-30f, std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::denorm_min(),
+                          std::numeric_limits<float>::min(), 0.0031308f, 0.5f, std::nextafter(1.f, 0.f)})
+        EXPECT_EQ(srgb8(x), srgb8_exact(x)) << x;
+    EXPECT_EQ(srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
+    std::uint32_t state = 12345;
+    int changes = 0;
+    for (int i = 0; i < 1000000; ++i) {
+        state = state * 1664525u + 1013904223u;
+        const float x = std::bit_cast<float>(state % 0x3F800001u);
+        ASSERT_EQ(srgb8(x), srgb8_exact(x)) << x;
+    }
+    for (int k = 1; k < 256; ++k) {
+        std::uint32_t lo = 0, hi = 0x3F800000u;  // the least float whose byte is k or more
+        while (lo < hi) {
+            const std::uint32_t mid = lo + (hi - lo) / 2;
+            if (srgb8_exact(std::bit_cast<float>(mid)) >= k) hi = mid;
+            else lo = mid + 1;
+        }
+        for (std::uint32_t b = lo - std::min(lo, 64u); b <= lo + 64; ++b)
+            ASSERT_EQ(srgb8(std::bit_cast<float>(b)), srgb8_exact(std::bit_cast<float>(b))) << k;
+        changes += srgb8_exact(std::bit_cast<float>(lo)) == k;
+    }
+    EXPECT_EQ(changes, 255);  // each byte is reached
 }
 
 // Image sizes, as text and as numbers: both sides in [1, 65536], at most 2^28 pixels, refused in the

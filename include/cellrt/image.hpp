@@ -2,6 +2,7 @@
 // for comparing two renders bit for bit).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,30 @@ struct Image {
 // never leaves a partial file under `path`. Refuses to replace an existing file unless `overwrite`.
 // Throws cellrt::Error naming the path on any failure.
 void write_image(const Image& image, const std::string& path, bool overwrite);
+
+// A frame as a PNG holds it: 8-bit sRGB, three bytes a pixel (red, green, blue), row-major, row 0 at
+// the top. cellrt-mpi's ranks send these for a frame written as PNG: a quarter of the float bytes.
+struct Srgb8Image {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgb;
+
+    Srgb8Image() = default;
+    Srgb8Image(int w, int h) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3) {}
+};
+
+// One linear channel's byte in a PNG: linear_to_srgb, scaled to [0, 255] and rounded (std::lround);
+// NaN gives 0. srgb8 gives the bytes of srgb8_exact by a table (built on first use, 260 KiB).
+std::uint8_t srgb8(float linear);
+std::uint8_t srgb8_exact(float linear);
+
+// The 8-bit sRGB pixels write_image puts in a PNG of `image`.
+Srgb8Image to_srgb8(const Image& image);
+
+// Writes a PNG of 8-bit pixels, as write_image does (atomically; `overwrite` as there): for the pixels
+// of to_srgb8(image) the very bytes of write_image(image) to a .png path. Throws cellrt::Error naming
+// the path on any failure, or when the path does not end in .png.
+void write_png(const Srgb8Image& image, const std::string& path, bool overwrite);
 
 // Reads a PFM written by write_image (for tests and comparisons).
 Image read_pfm(const std::string& path);
