@@ -13,8 +13,10 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
+#include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 
@@ -57,10 +59,15 @@ void together(const std::function<void()>& step, const std::string& name);
 // The scene `spec` on every process (cellrt::load_scene in the plain program).
 Scene load_scene(const std::string& spec);
 
+// A rendered frame: linear floats, or the 8-bit sRGB pixels of its PNG.
+using Frame = std::variant<Image, Srgb8Image>;
+
 // Renders the frame with every process (cellrt::render in the plain program). On the leader `frame`
 // and `stats` receive the frame and its figures and `report` what each process did (left alone in
-// the plain program, whose figures are its workers'); elsewhere they are left alone.
-void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
+// the plain program, whose figures are its workers'); elsewhere they are left alone. With `png` (the
+// frame is written as PNG) cellrt-mpi's ranks send their pixels as the PNG's bytes, a quarter of the
+// floats, and `frame` holds those; the plain program renders floats either way.
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, bool png, Frame& frame,
             RenderStats& stats, nlohmann::json& report);
 
 // The independent runs 0..count-1 this process traces: every `ranks()`-th from rank().

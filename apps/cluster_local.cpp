@@ -23,9 +23,9 @@ void add_bench_options(CLI::App&) {}
 void together(const std::function<void()>& step, const std::string&) { step(); }
 Scene load_scene(const std::string& spec) { return cellrt::load_scene(spec); }
 
-void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, bool, Frame& frame,
             RenderStats& stats, nlohmann::json&) {
-    cellrt::render(scene, accel, options, frame, &stats);
+    cellrt::render(scene, accel, options, frame.emplace<Image>(), &stats);
 }
 
 std::vector<std::size_t> share(std::size_t count) {

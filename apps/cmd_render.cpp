@@ -241,11 +241,12 @@ Runner add_render(CLI::App& app) {
         Progress progress;
         if (cluster::leader()) ro.progress = [&](std::size_t d, std::size_t t) { progress(d, t); };
         RenderStats rs;
-        Image image;
+        cluster::Frame frame;
         nlohmann::json ranks_report = nlohmann::json::object();
-        cluster::render(scene, accel, ro, image, rs, ranks_report);
+        cluster::render(scene, accel, ro, lower_extension(o->out) == ".png", frame, rs, ranks_report);
         if (!cluster::leader()) return 0;
-        write_image(image, o->out, o->overwrite);
+        if (const Image* image = std::get_if<Image>(&frame)) write_image(*image, o->out, o->overwrite);
+        else write_png(std::get<Srgb8Image>(frame), o->out, o->overwrite);
         const AccelStats st = accel.stats();
         std::printf("%s: %zu triangles, %dx%d, %s, load %.3f s, build %.3f s, render %.3f s (%.2f Mrays/s) -> %s\n",
                     scene.name.c_str(), scene.triangles.size(), ro.width, ro.height, st.name.c_str(), load_s,

@@ -107,6 +107,20 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             const std::string report = read(stats);
             EXPECT_EQ(count(report, "\"tiles\""), static_cast<std::size_t>(ranks)) << report;
             EXPECT_NE(report.find("\"busy_seconds\""), std::string::npos);
+            EXPECT_NE(report.find("\"float\""), std::string::npos) << report;
+        }
+        // A PNG's pixels travel as its 8-bit bytes, made on each rank: the plain program's PNG.
+        const fs::path png = dir.path / (name + "plain.png");
+        ASSERT_EQ(shell(plain + " render " + frame + " -o " + png.string(), dir.path).status, 0) << c.options;
+        for (int ranks : {2, 3}) {
+            const fs::path out = dir.path / (name + "mpi" + std::to_string(ranks) + ".png");
+            const fs::path stats = dir.path / (name + "mpi" + std::to_string(ranks) + "png.json");
+            const std::string command = mpirun(ranks) + mpi + " render " + frame + " --tile " + std::to_string(c.tile) +
+                                        " -o " + out.string() + " --stats " + stats.string();
+            const Outcome o = shell(command, dir.path);
+            ASSERT_EQ(o.status, 0) << command << "\n" << o.err;
+            EXPECT_EQ(read(out), read(png)) << c.options << ", " << ranks << " ranks, PNG";
+            EXPECT_NE(read(stats).find("\"srgb8\""), std::string::npos) << read(stats);
         }
     }
 }

@@ -93,13 +93,16 @@ Scene load_scene(const std::string& spec) {
     return distributed::load_scene_on_every_rank(session(), spec, g_options.broadcast_scene);
 }
 
-void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, Image& frame,
+void render(const Scene& scene, const Accelerator& accel, const RenderOptions& options, bool png, Frame& frame,
             RenderStats& stats, nlohmann::json& report) {
     std::vector<distributed::RankLoad> loads;
-    distributed::render_tiles(session(), scene, accel, options, g_options.tiles, frame, &stats, &loads);
+    distributed::TileOptions tiles = g_options.tiles;
+    tiles.srgb8 = png;
+    distributed::render_tiles(session(), scene, accel, options, tiles, frame, &stats, &loads);
     if (!leader()) return;
-    report["tile"] = g_options.tiles.tile;
-    report["ahead"] = g_options.tiles.ahead;
+    report["tile"] = tiles.tile;
+    report["ahead"] = tiles.ahead;
+    report["pixels"] = tiles.srgb8 ? "srgb8" : "float";
     report["scene_from"] = g_options.broadcast_scene ? "broadcast" : "path";
     report["ranks"] = nlohmann::json::array();
     for (std::size_t r = 0; r < loads.size(); ++r) {

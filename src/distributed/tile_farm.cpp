@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <variant>
 
 #include "core/timer.hpp"
 
@@ -65,10 +66,33 @@ struct TileGrid {
     }
 };
 
-void copy_into(Image& frame, const PixelRect& r, const Vec3* pixels) {
+// Bytes a pixel takes on the way to rank 0.
+std::size_t pixel_bytes(bool as_srgb8) { return as_srgb8 ? 3 : sizeof(Vec3); }
+
+// A traced tile's pixels as they travel: its floats, or each channel's PNG byte.
+void append_pixels(std::string& bytes, const Image& tile, bool as_srgb8) {
+    if (!as_srgb8) {
+        bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
+        return;
+    }
+    const Srgb8Image rgb = to_srgb8(tile);
+    bytes.append(reinterpret_cast<const char*>(rgb.rgb.data()), rgb.rgb.size());
+}
+
+// Puts a tile's travelled pixels (its rect's rows, packed) in their place in the frame.
+void copy_into(Image& frame, const PixelRect& r, const char* pixels) {
+    const std::size_t row = sizeof(Vec3) * static_cast<std::size_t>(r.width());
     for (int y = r.y0; y < r.y1; ++y)
-        std::memcpy(&frame.at(r.x0, y), pixels + static_cast<std::size_t>(y - r.y0) * r.width(),
-                    sizeof(Vec3) * static_cast<std::size_t>(r.width()));
+        std::memcpy(&frame.at(r.x0, y), pixels + static_cast<std::size_t>(y - r.y0) * row, row);
+}
+void copy_into(Srgb8Image& frame, const PixelRect& r, const char* pixels) {
+    const std::size_t row = 3 * static_cast<std::size_t>(r.width());
+    for (int y = r.y0; y < r.y1; ++y)
+        std::memcpy(&frame.rgb[3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(frame.width) + r.x0)],
+                    pixels + static_cast<std::size_t>(y - r.y0) * row, row);
+}
+void copy_into(TileFrame& frame, const PixelRect& r, const char* pixels) {
+    std::visit([&](auto& f) { copy_into(f, r, pixels); }, frame);
 }
 
 void add_tile(RankLoad& load, const RenderStats& s, std::size_t packets) {
@@ -159,7 +183,7 @@ std::unique_ptr<FrameRenderer> start_renderer(const Scene& scene, const Accelera
 // sent each tile's last fragments a tile or more late and waited for its next tile (with Open MPI
 // and no single-copy transport, 16 ranks on one machine: busy 40 % of the frame; docs/DISTRIBUTED.md).
 RankLoad trace_for_master(const Session& session, const Scene& scene, const Accelerator& accel,
-                          const RenderOptions& options, const TileGrid& grid, int ahead,
+                          const RenderOptions& options, const TileGrid& grid, int ahead, bool as_srgb8,
                           std::optional<std::string>& failure) {
     const RenderOptions o = tile_options(options);
     RankLoad load;
@@ -196,8 +220,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
                     add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                     header.outcome = Outcome::traced;
                     header.seconds = s.seconds;
-                    bytes.append(reinterpret_cast<const char*>(tile.pixels.data()),
-                                 tile.pixels.size() * sizeof(Vec3));
+                    append_pixels(bytes, tile, as_srgb8);
                 } catch (const std::exception& e) {
                     failure = e.what();
                     header.outcome = Outcome::failed;
@@ -269,7 +292,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
 
 // Rank 0: hands out tiles and gathers them into `frame`, while a thread of its own traces tiles too.
 RankLoad master(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
-                const TileGrid& grid, int ahead, Image& frame, std::optional<std::string>& failure) {
+                const TileGrid& grid, int ahead, bool as_srgb8, TileFrame& frame, std::optional<std::string>& failure) {
     const auto ranks = static_cast<std::size_t>(session.size());
     const std::size_t count = grid.count();
     std::size_t all_packets = 0;
@@ -298,7 +321,9 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
                 RenderStats s;
                 const PixelRect r = grid.rect(static_cast<std::size_t>(t));
                 renderer->render_window(r, tile, &s);
-                copy_into(frame, r, tile.pixels.data());
+                std::string bytes;
+                append_pixels(bytes, tile, as_srgb8);
+                copy_into(frame, r, bytes.data());
                 add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                 gathered += grid.packets(static_cast<std::size_t>(t));
             } catch (const std::exception& e) {
@@ -332,7 +357,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     std::size_t max_tile_pixels = 0;
     for (std::size_t t = 0; t < count; ++t)
         max_tile_pixels = std::max(max_tile_pixels, static_cast<std::size_t>(grid.rect(t).pixels()));
-    const std::size_t buffer_bytes = sizeof(ResultHeader) + std::max(max_tile_pixels * sizeof(Vec3), kMaxCause);
+    const std::size_t buffer_bytes = sizeof(ResultHeader) + std::max(max_tile_pixels * pixel_bytes(as_srgb8), kMaxCause);
     std::vector<std::string> buffers(ranks);
     std::vector<MPI_Request> requests(ranks, MPI_REQUEST_NULL);
     auto answer = [&](std::size_t r) {
@@ -367,7 +392,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
                 tile_time[r] = tile_time[r] > 0.0 ? 0.75 * tile_time[r] + 0.25 * header.seconds : header.seconds;
             if (header.outcome == Outcome::traced) {
                 const auto t = static_cast<std::size_t>(header.tile);
-                copy_into(frame, grid.rect(t), reinterpret_cast<const Vec3*>(buffers[r].data() + sizeof header));
+                copy_into(frame, grid.rect(t), buffers[r].data() + sizeof header);
                 gathered += grid.packets(t);
             } else if (header.outcome == Outcome::failed) {
                 stop = true;  // the rank reports its cause itself when the ranks agree
@@ -446,7 +471,7 @@ unsigned rank_threads(unsigned threads) {
 }
 
 void render_tiles(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
-                  const TileOptions& tiles, Image& frame, RenderStats* stats, std::vector<RankLoad>* loads) {
+                  const TileOptions& tiles, TileFrame& frame, RenderStats* stats, std::vector<RankLoad>* loads) {
     if (tiles.tile < 1 || tiles.tile > kMaxImageSide)
         throw Error("tile edge " + std::to_string(tiles.tile) + " must lie in [1, " + std::to_string(kMaxImageSide) +
                     "]");
@@ -460,11 +485,11 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
     Timer timer;
     RankLoad mine;
     if (session.leader()) {
-        if (frame.width != options.width || frame.height != options.height)
-            frame = Image(options.width, options.height);
-        mine = master(session, scene, accel, options, grid, tiles.ahead, frame, failure);
+        if (tiles.srgb8) frame = Srgb8Image(options.width, options.height);
+        else frame = Image(options.width, options.height);
+        mine = master(session, scene, accel, options, grid, tiles.ahead, tiles.srgb8, frame, failure);
     } else {
-        mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, failure);
+        mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, tiles.srgb8, failure);
     }
     const double seconds = timer.seconds();
     session.agree(failure, "the frame");

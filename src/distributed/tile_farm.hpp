@@ -10,8 +10,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <variant>
 #include <vector>
 
+#include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "distributed/session.hpp"
 
@@ -20,7 +22,13 @@ namespace cellrt::distributed {
 struct TileOptions {
     int tile = 128;  // tile edge in pixels (the frame's edge tiles are cut to it)
     int ahead = 3;   // tiles a rank holds: the one it traces and those queued behind it
+    // Tiles travel as 8-bit sRGB pixels, 3 bytes where floats take 12: for a frame written as PNG,
+    // whose bytes each rank makes from its own pixels as the PNG writer would (cellrt/image.hpp).
+    bool srgb8 = false;
 };
+
+// The frame rank 0 gathers: linear floats, or with TileOptions::srgb8 the PNG's 8-bit pixels.
+using TileFrame = std::variant<Image, Srgb8Image>;
 
 inline constexpr int kMaxAhead = 64;
 
@@ -36,13 +44,14 @@ struct RankLoad {
 };
 
 // Renders the frame of `options` (width x height) on every rank: each calls it with the same scene,
-// structure and options. On rank 0, `frame` receives the image, `stats` the frame's figures (rays of
+// structure and options. On rank 0, `frame` receives the image (the alternative that tiles.srgb8
+// names), `stats` the frame's figures (rays of
 // all ranks; seconds: rank 0's wall time for the frame) and `loads` one RankLoad per rank; on the
 // others they are left alone. options.progress is called on rank 0 with the frame's packets gathered.
 // A rank that fails (a tracer's exception, a cancelled render) stops the frame: every rank throws
 // AgreedError naming it. A rank that stops answering ends the job after the session's time-out.
 void render_tiles(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
-                  const TileOptions& tiles, Image& frame, RenderStats* stats, std::vector<RankLoad>* loads);
+                  const TileOptions& tiles, TileFrame& frame, RenderStats* stats, std::vector<RankLoad>* loads);
 
 // The worker threads a rank runs for options.threads == 0: the cores it may run on (mpirun binds a
 // rank to its share of a machine's cores), not all of the machine's.
