@@ -143,17 +143,19 @@ run)
   # Runs of `cellrt render` and `cellrt-mpi render` of Sponza at 1080p (docs/DISTRIBUTED.md), five rounds
   # with the configurations in turn, each frame compared byte for byte with the first configuration's;
   # each run's time is rank 0's render_seconds in its --stats file, without start-up, loading and
-  # building. mpi_rounds INTO NAME=PROGRAM ARGS...
+  # building. Frames are written as .pfm (float pixels), or as .png with FRAME_EXT=png (cellrt-mpi's
+  # ranks then send 8-bit pixels). mpi_rounds INTO NAME=PROGRAM ARGS...
   mpi_rounds() {
-    local into="$1" first="${2%%=*}" spec name args r
+    local into="$1" first="${2%%=*}" ext="${FRAME_EXT:-pfm}" spec name args r
     shift
+    mkdir -p "$into"
     for r in 1 2 3 4 5; do
       for spec in "$@"; do
         name="${spec%%=*}"
         read -ra args <<<"${spec#*=}"
-        "$run" "${args[@]}" --size 1920x1080 -o "$frames/$name.pfm" --stats "$into/$name.$r.json" --overwrite \
+        "$run" "${args[@]}" --size 1920x1080 -o "$frames/$name.$ext" --stats "$into/$name.$r.json" --overwrite \
           > /dev/null || echo "$name: status $?"
-        cmp "$frames/$name.pfm" "$frames/$first.pfm" || echo "$name: the frame differs"
+        cmp "$frames/$name.$ext" "$frames/$first.$ext" || echo "$name: the frame differs"
       done
     done
   }
@@ -171,6 +173,12 @@ run)
       "mpi16_tile64=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 64" \
       "mpi8x2=$mpi -np 8 cellrt-mpi render $sponza --threads 2" \
       "mpi16_cma=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1"
+    # The same frame written as PNG: the ranks send 8-bit pixels, a quarter of the floats' bytes.
+    export FRAME_EXT=png
+    timed mpi16_png 60 bash -c 'mpi_rounds "$@"' _ "$res/mpi_png" "plain_t16=$plain --threads 16" \
+      "plain_t1=$plain --threads 1" "mpi16=$mpi -np 16 cellrt-mpi render $sponza --threads 1" \
+      "mpi16_tile64=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 64"
+    unset FRAME_EXT
   fi
   # What holds 16 ranks back (not by default): tiles held ahead, tile edge, binding, ranks, transport.
   if [[ -x "$dir/bundle/bin/cellrt-mpi" ]] && named mpi16_sweep; then
