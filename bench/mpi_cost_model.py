@@ -6,7 +6,7 @@ and 64-pixel tiles); the network's are assumed (an InfiniBand-class fabric) and 
 For each N the tile edge (of 256, 128, 64, 32, 16) that gives the shortest frame is chosen.
 
   python3 bench/mpi_cost_model.py --frame-cpu 0.44 --tile-cpu 0.0001 [--cores 2] [--size 1920x1080]
-      [--slowdown S] [--tile EDGE]
+      [--slowdown S] [--tile EDGE] [--pixel-bytes 3]
 """
 import argparse
 import math
@@ -17,7 +17,7 @@ def frame_time(n_nodes, a, edge):
     tiles = math.ceil(w / edge) * math.ceil(h / edge)
     t1 = a.frame_cpu / a.cores                      # one node's frame, all its cores tracing
     t_tile = a.slowdown * t1 / tiles                 # one tile on one node, every core of it busy
-    tile_bytes = 12 * edge * edge                    # float RGB
+    tile_bytes = a.pixel_bytes * edge * edge         # float RGB (12) or a PNG's 8-bit sRGB (3)
     # A rank asks ahead: the next tile is there unless an answer takes longer than the tiles queued.
     answer = a.poll / 2 + 2 * a.latency + tile_bytes / (a.transfer or a.bandwidth)
     starve = max(0.0, answer - (a.ahead - 1) * t_tile)
@@ -26,7 +26,7 @@ def frame_time(n_nodes, a, edge):
     if per_rank_tiles < 1:                           # more nodes than tiles: one tile is the frame
         trace = t_tile + a.tile_cpu + starve
     # Rank 0's master receives every tile through one network port and copies it into the frame.
-    master = tiles * a.message + 12 * w * h / a.bandwidth + 12 * w * h / a.copy
+    master = tiles * a.message + a.pixel_bytes * w * h / a.bandwidth + a.pixel_bytes * w * h / a.copy
     return max(trace, master) + a.collectives * math.ceil(math.log2(max(n_nodes, 2))) * a.latency, tiles
 
 
@@ -49,6 +49,8 @@ def main():
     p.add_argument("--copy", type=float, default=5e9, help="rank 0's memory copy into the frame, B/s (assumed)")
     p.add_argument("--message", type=float, default=5e-6, help="rank 0's handling of one tile message, s (assumed)")
     p.add_argument("--collectives", type=int, default=3, help="collectives per frame (agreement, figures)")
+    p.add_argument("--pixel-bytes", type=int, default=12,
+                   help="bytes a pixel travels in: 12 (float RGB, a .pfm frame) or 3 (8-bit sRGB, a .png frame)")
     p.add_argument("--scene-bytes", type=float, default=66454 * 36, help="triangles broadcast, bytes")
     a = p.parse_args()
     a.width, a.height = map(int, a.size.split("x"))

@@ -1,6 +1,6 @@
 // Every float from +0 to 1 in order (1,065,353,217 of them): the byte of a PNG channel
 // (cellrt::srgb8_exact: lround(255 * linear_to_srgb(x))) never falls, and cellrt::srgb8, its table,
-// gives the same byte. The table rests on the first; docs/FORMATS.md, "PNG bytes". About 10 s.
+// gives the same byte. The table rests on the first; docs/DISTRIBUTED.md, "8-bit pixels". About 10 s.
 //   g++ -I include -O2 -std=c++20 docs/figures/srgb8_check.cpp build/libcellrt.a -lstb -o srgb8_check
 #include <bit>
 #include <cstdint>

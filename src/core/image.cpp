@@ -51,7 +51,7 @@ namespace {
 
 // srgb8_exact by table, the same bytes in a fraction of the time (a power per channel was some 15 % of
 // a 1080p frame's CPU time on cellrt-mpi's ranks). The byte never falls as the input rises through
-// the floats of [0, 1] (all 1,065,353,217 of them checked: docs/FORMATS.md), so it is the number of
+// the floats of [0, 1] (all 1,065,353,217 of them checked: docs/DISTRIBUTED.md, "8-bit pixels"), so it is the number of
 // thresholds t_1..t_255, the least float giving each byte, at or below the input. Non-negative
 // floats order as their bit patterns: the floats of [0, 1) fall in buckets of 4,096 consecutive
 // patterns, each holding the byte of its least float, and an input steps over the one threshold its
