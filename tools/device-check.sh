@@ -14,8 +14,8 @@
 # --device cuda`), gpu_tests.json (the GPU tests, GoogleTest's JSON), gpu_bench.json and .log (the GPU
 # benchmark beside Embree on all host cores, same rays), cache_study/ (the study's cache sweeps in the
 # GPU's shared memory, memory mode (b), synchronous), scaling_pull_16core.json (the CPU scaling curve,
-# docs/SCALING.md), builds_t1/t16 and builds_forest_t1/t16.json (docs/BUILD_SPEED.md), mpi/ (16 ranks
-# against one process, docs/DISTRIBUTED.md) and cache_study_async/ (the node cache's sweep with
+# docs/SCALING.md), builds_t1/t16 and builds_forest_t1/t16.json (docs/BUILD_SPEED.md), mpi/ and mpi_png/
+# (16 ranks against one process, frames as .pfm and as .png, docs/DISTRIBUTED.md) and cache_study_async/ (the node cache's sweep with
 # asynchronous access). Each step runs under a time limit of its own and the run's deadline.
 # With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=600).
 set -euo pipefail
