@@ -407,13 +407,13 @@ private:
             else
                 for (std::size_t i = begin; i < end; ++i) seen += goes[i];
         }
-        std::vector<std::size_t> partner(misplaced);
+        std::vector<std::uint32_t> partner(misplaced);  // positions within the range (< 2^30)
         for_blocks(
             n,
             [&](std::size_t begin, std::size_t end) {
                 std::size_t rank = high_rank[begin / kRangeBlock];
                 for (std::size_t i = end; i-- > std::max(begin, mid);)
-                    if (goes[i]) partner[rank++] = i;
+                    if (goes[i]) partner[rank++] = static_cast<std::uint32_t>(i);
             },
             kRangeBlock);
         for_blocks(
