@@ -216,8 +216,11 @@ private:
     void build_into(BihTree& tree) {
         const std::size_t n = tris_.size();
         items_.resize(n);
-        if (p_.threads != 1)
-            range_pass_min_ = std::max(p_.parallel_pass_min, n / static_cast<std::size_t>(build_concurrency(p_.threads)) + 1);
+        if (p_.threads != 1) {
+            // The threads asked for (all cores for 0), even beyond the machine's: the tree is the same.
+            const std::size_t threads = p_.threads != 0 ? p_.threads : static_cast<std::size_t>(build_concurrency(0));
+            range_pass_min_ = std::max(p_.parallel_pass_min, n / threads + 1);
+        }
         std::vector<Bounds> blocks((n + kBlock - 1) / kBlock);
         for_blocks(n, [&](std::size_t begin, std::size_t end) {
             Bounds& b = blocks[begin / kBlock];
@@ -608,7 +611,8 @@ private:
     // its share of the triangles (n / threads: above it the build's tasks are fewer than its threads,
     // and a range's partition would hold the others up), and of parallel_pass_min at least. Smaller
     // ranges run their passes on one thread, which is less work (the partition in blocks takes four
-    // passes over its range, Hoare's one).
+    // passes over its range, Hoare's one). The threads are those asked for, so that a test asking
+    // for four reaches the second level on a machine of two cores.
     std::size_t range_pass_min_ = std::numeric_limits<std::size_t>::max();
     std::vector<Item> items_;
 };
