@@ -256,7 +256,7 @@ private:
         }
         tree.nodes = {BihNode{}, BihNode::leaf(0, 0)};
         std::vector<std::uint32_t> no_indices;
-        flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH");
+        flatten(*top, 0, tree.nodes, no_indices, BihNode::kMaxIndex, "BIH", p_.threads != 1);
         for_blocks(n, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i) {
                 tree.triangles[i] = tris_[items_[i].triangle];

@@ -143,16 +143,17 @@ public:
         if (tris_.empty()) root.cell = Box3{Vec3(0.f), Vec3(0.f)};
         root.bounds = root.cell;
         tree.bounds = root.cell;
-        std::unique_ptr<Subtree<KdNode>> top;
-        auto run = [&] { top = subtree(std::move(root)); };
+        tree.nodes.resize(2);
+        auto run = [&] {
+            const std::unique_ptr<Subtree<KdNode>> top = subtree(std::move(root));
+            flatten(*top, 0, tree.nodes, tree.indices, KdNode::kMaxIndex, "kd-tree", p_.threads != 1);
+        };
         if (p_.threads == 1) {
             run();
         } else {
             tbb::task_arena arena(build_concurrency(p_.threads));
             arena.execute(run);
         }
-        tree.nodes.resize(2);
-        flatten(*top, 0, tree.nodes, tree.indices, KdNode::kMaxIndex, "kd-tree");
         return tree;
     }
 
