@@ -136,14 +136,15 @@ void flatten(const Subtree<Node>& s, std::uint32_t slot, std::vector<Node>& node
     std::vector<PiecePlace<Node>> places;
     plan_pieces(s, slot, nodes, next_node, next_index, places, max_index, structure);
     tbb::parallel_for(std::size_t{0}, places.size(), [&](std::size_t p) {
-        const auto& [piece, root_slot, base, first_index] = places[p];
-        std::copy(piece->indices.begin(), piece->indices.end(), indices.begin() + static_cast<std::ptrdiff_t>(first_index));
+        const PiecePlace<Node>& at = places[p];
+        const Subtree<Node>& piece = *at.piece;
+        std::copy(piece.indices.begin(), piece.indices.end(), indices.begin() + static_cast<std::ptrdiff_t>(at.first_index));
         auto place = [&](std::uint32_t local) {
-            return local == 0 ? root_slot : static_cast<std::uint32_t>(base + local - 1);
+            return local == 0 ? at.slot : static_cast<std::uint32_t>(at.base + local - 1);
         };
-        for (std::uint32_t i = 0; i < piece->nodes.size(); ++i) {
-            const Node& n = piece->nodes[i];
-            nodes[place(i)] = n.is_leaf() ? n.with_index(static_cast<std::uint32_t>(first_index) + n.first())
+        for (std::uint32_t i = 0; i < piece.nodes.size(); ++i) {
+            const Node& n = piece.nodes[i];
+            nodes[place(i)] = n.is_leaf() ? n.with_index(static_cast<std::uint32_t>(at.first_index) + n.first())
                                           : n.with_index(place(n.children()));
         }
     });
