@@ -94,6 +94,12 @@ void copy_into(Srgb8Image& frame, const PixelRect& r, const char* pixels) {
 void copy_into(TileFrame& frame, const PixelRect& r, const char* pixels) {
     std::visit([&](auto& f) { copy_into(f, r, pixels); }, frame);
 }
+// Rank 0's own traced tile, in the frame's pixels.
+void copy_into(TileFrame& frame, const PixelRect& r, const Image& tile) {
+    if (Image* linear = std::get_if<Image>(&frame))
+        return copy_into(*linear, r, reinterpret_cast<const char*>(tile.pixels.data()));
+    copy_into(std::get<Srgb8Image>(frame), r, reinterpret_cast<const char*>(to_srgb8(tile).rgb.data()));
+}
 
 void add_tile(RankLoad& load, const RenderStats& s, std::size_t packets) {
     ++load.tiles;
@@ -290,9 +296,10 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     return load;
 }
 
-// Rank 0: hands out tiles and gathers them into `frame`, while a thread of its own traces tiles too.
+// Rank 0: hands out tiles and gathers them into `frame` (in the pixels of the alternative it holds),
+// while a thread of its own traces tiles too.
 RankLoad master(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
-                const TileGrid& grid, int ahead, bool as_srgb8, TileFrame& frame, std::optional<std::string>& failure) {
+                const TileGrid& grid, int ahead, TileFrame& frame, std::optional<std::string>& failure) {
     const auto ranks = static_cast<std::size_t>(session.size());
     const std::size_t count = grid.count();
     std::size_t all_packets = 0;
@@ -321,9 +328,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
                 RenderStats s;
                 const PixelRect r = grid.rect(static_cast<std::size_t>(t));
                 renderer->render_window(r, tile, &s);
-                std::string bytes;
-                append_pixels(bytes, tile, as_srgb8);
-                copy_into(frame, r, bytes.data());
+                copy_into(frame, r, tile);
                 add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                 gathered += grid.packets(static_cast<std::size_t>(t));
             } catch (const std::exception& e) {
@@ -357,7 +362,8 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     std::size_t max_tile_pixels = 0;
     for (std::size_t t = 0; t < count; ++t)
         max_tile_pixels = std::max(max_tile_pixels, static_cast<std::size_t>(grid.rect(t).pixels()));
-    const std::size_t buffer_bytes = sizeof(ResultHeader) + std::max(max_tile_pixels * pixel_bytes(as_srgb8), kMaxCause);
+    const std::size_t buffer_bytes =
+        sizeof(ResultHeader) + std::max(max_tile_pixels * pixel_bytes(std::holds_alternative<Srgb8Image>(frame)), kMaxCause);
     std::vector<std::string> buffers(ranks);
     std::vector<MPI_Request> requests(ranks, MPI_REQUEST_NULL);
     auto answer = [&](std::size_t r) {
@@ -487,7 +493,7 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
     if (session.leader()) {
         if (tiles.srgb8) frame = Srgb8Image(options.width, options.height);
         else frame = Image(options.width, options.height);
-        mine = master(session, scene, accel, options, grid, tiles.ahead, tiles.srgb8, frame, failure);
+        mine = master(session, scene, accel, options, grid, tiles.ahead, frame, failure);
     } else {
         mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, tiles.srgb8, failure);
     }
