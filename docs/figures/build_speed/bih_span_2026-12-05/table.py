@@ -10,7 +10,10 @@ import os
 import statistics as st
 import sys
 
+# table.py [DIR [CONFIG...]]: the runs in DIR (this folder's by default), the configurations named
+# (by default the BIH's two builds and Embree's).
 here = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+configs = sys.argv[2:] or ['bih@split=sah', 'bih', 'embree']
 runs = collections.defaultdict(list)
 for f in glob.glob(os.path.join(here, '*.json')):
     v, t, r = os.path.basename(f)[:-5].split('.')
@@ -19,7 +22,7 @@ for f in glob.glob(os.path.join(here, '*.json')):
 
 print('| structure | scene | old: 1 / 2 threads ms, speed-up | new | 1 thread, new ÷ old | 2 threads, new ÷ old | speed-up per round, old → new |')
 print('|---|---|---|---|--:|--:|---|')
-for c in ('bih@split=sah', 'bih', 'embree'):
+for c in configs:
     for s in ('sponza', 'sibenik', 'bunny', 'teapot', 'forest'):
         m = {(v, t): st.median(b for _, b in runs[(v, t, s, c)]) for v in ('old', 'new') for t in (1, 2)}
         if not all(m.values()):

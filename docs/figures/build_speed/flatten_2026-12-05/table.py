@@ -1,33 +1,11 @@
 #!/usr/bin/env python3
 """The kd-tree's and the SAH BIH's builds on 1 and 2 threads, 08d9392 (old: the layout on one thread)
 against the layout on the build's threads (new), five rounds in turn (run.sh; docs/BUILD_SPEED.md,
-"The layout on the build's threads"). Per side, the median of its runs' medians of five builds; per
-round, the two-thread speed-up."""
-import collections
-import glob
-import json
+"The layout on the build's threads"): bih_span_2026-12-05/table.py's table of these runs."""
 import os
-import statistics as st
+import runpy
 import sys
 
-here = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
-runs = collections.defaultdict(list)
-for f in glob.glob(os.path.join(here, '*.json')):
-    v, t, r = os.path.basename(f)[:-5].split('.')
-    for x in json.load(open(f)):
-        runs[(v, int(t[1:]), x['scene'], x['config'])].append((int(r[1:]), x['build_seconds']))
-
-print('| structure | scene | old: 1 / 2 threads ms, speed-up | new | 1 thread, new ÷ old | 2 threads, new ÷ old | speed-up per round, old → new |')
-print('|---|---|---|---|--:|--:|---|')
-for c in ('kd', 'bih@split=sah', 'embree'):
-    for s in ('sponza', 'sibenik', 'bunny', 'teapot', 'forest'):
-        m = {(v, t): st.median(b for _, b in runs[(v, t, s, c)]) for v in ('old', 'new') for t in (1, 2)}
-        if not all(m.values()):
-            continue
-        per_round = {}
-        for v in ('old', 'new'):
-            one, two = dict(runs[(v, 1, s, c)]), dict(runs[(v, 2, s, c)])
-            per_round[v] = ', '.join(f'{one[r] / two[r]:.2f}' for r in sorted(one))
-        cells = [f'{m[(v, 1)] * 1e3:.1f} / {m[(v, 2)] * 1e3:.1f}, {m[(v, 1)] / m[(v, 2)]:.2f}' for v in ('old', 'new')]
-        print(f"| {c} | {s} | {cells[0]} | {cells[1]} | {m[('new', 1)] / m[('old', 1)]:.3f} | "
-              f"{m[('new', 2)] / m[('old', 2)]:.3f} | {per_round['old']} → {per_round['new']} |")
+here = os.path.dirname(os.path.abspath(__file__))
+sys.argv = [sys.argv[0], sys.argv[1] if len(sys.argv) > 1 else here, 'kd', 'bih@split=sah', 'embree']
+runpy.run_path(os.path.join(here, '..', 'bih_span_2026-12-05', 'table.py'), run_name='__main__')
