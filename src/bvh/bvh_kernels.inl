@@ -447,6 +447,19 @@ inline void any_paired_batch(const BvhTree& tree, std::span<const Ray> rays, std
     });
 }
 
+// Fetches the lines of a child that a packet or a stream pushes (four of a node, five of a leaf), so
+// that they arrive while it goes down its nearest child; one ray at a time has too little to do in
+// between. Measured (docs/INCOHERENT.md, "Twelfth round"): the BVH's packets trace a frame's shadow
+// rays 12 to 16 % faster and AO rays 5 to 8 %; the same prefetch of the child a single ray pushed
+// last gained nothing.
+inline void prefetch_child(const BvhNode* nodes, const BvhLeaf* leaves, std::uint32_t word) {
+    static_assert(sizeof(BvhNode) == 4 * 64 && sizeof(BvhLeaf) == 5 * 64);
+    const bool leaf = BvhNode::is_leaf(word);
+    const char* p = leaf ? reinterpret_cast<const char*>(&leaves[BvhNode::leaf_index(word)])
+                         : reinterpret_cast<const char*>(&nodes[word]);
+    for (int i = 0; i < (leaf ? 5 : 4); ++i) __builtin_prefetch(p + 64 * i);
+}
+
 #include "bvh/bvh_stream.inl"
 #include "bvh/bvh_packet.inl"
 

@@ -157,6 +157,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const Ray* ba
                     for (unsigned rest = met & ~(1u << next); rest; rest &= rest - 1) {
                         const int k = __builtin_ctz(rest);
                         const PacketFrame f{node.child[k], child_rays[k], kAny ? 0.f : key[k]};
+                        prefetch_child(nodes, leaves, f.word);
                         int at = size++;
                         if constexpr (!kAny) {
                             for (; at > bottom && stack[at - 1].entry < f.entry; --at) stack[at] = stack[at - 1];

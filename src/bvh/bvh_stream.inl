@@ -203,6 +203,7 @@ void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s,
         for (int i = 0; i < n_pushed; ++i) {
             const int child = pushed[i];
             frames[size++] = {node.child[child], top, static_cast<std::uint32_t>(counts[child])};
+            prefetch_child(nodes, leaves, node.child[child]);
             std::uint32_t end = top;
             for (std::uint32_t r = 0; r < m; ++r) {
                 arena[end] = {met_ray[r], met_entry[std::size_t{r} * kBvhWidth + child]};
