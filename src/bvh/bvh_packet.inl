@@ -5,9 +5,9 @@
 // some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
 // query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top).
 // So a coherent packet reads each node, pops the stack and takes each branch once for its eight rays,
-// where single rays (bvh_kernels.inl) do it once per ray; the arithmetic is the same. When one ray is
-// left on a branch it goes on alone, with the single-ray kernel, from the node it reached
-// (kPacketSingleBelow).
+// where single rays (bvh_kernels.inl) do it once per ray; the arithmetic is the same. When few rays
+// are left on a branch (kPacketSingleBelow) each goes on alone, with the single-ray kernel, from the
+// node it reached.
 //
 // Exact: a ray's box test is meet_children's, lane for lane (the same operations in the same order,
 // the plane it enters and leaves by chosen by its own direction's signs), and its leaves are tested
@@ -23,7 +23,11 @@
 inline constexpr int kPacketRays = kLanes;
 // A branch that this many rays of a packet or fewer go down is traced by each ray alone (the
 // single-ray kernel), as Embree's hybrid traversal falls back to single rays when few lanes are left.
-inline constexpr int kPacketSingleBelow = 1;
+// Any hit: three, where one traced the shadow rays of a frame 12 to 15 % slower and AO rays 3 to 5 %
+// (two as fast as three, four and six slower); closest hit: one, where two and three cost the camera
+// rays 2 to 5 % (docs/INCOHERENT.md, "Twelfth round").
+template <class Query>
+inline constexpr int kPacketSingleBelow = Query::kAnyHit ? 3 : 1;
 
 // A packet's rays as the box tests read them, one ray per lane.
 struct PacketRays {
@@ -117,7 +121,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const Ray* ba
     std::uint32_t word = 0;
     unsigned mask = rays;
     for (;;) {
-        if (__builtin_popcount(mask) > kPacketSingleBelow) {
+        if (__builtin_popcount(mask) > kPacketSingleBelow<Query>) {
             if (BvhNode::is_leaf(word)) {
                 const BvhLeaf& leaf = leaves[BvhNode::leaf_index(word)];
                 const std::uint32_t count = BvhNode::leaf_count(word);
