@@ -1,0 +1,21 @@
+#!/bin/sh
+# Twelfth round (issue 18): the BVH's packets and streams fetch the children they push.
+# OLD: cellrt_bench of the commit before (git worktree add /tmp/old REV, built with -DCELLRT_CUDA=OFF
+# -DCELLRT_TESTS=OFF); NEW: this commit's. Run from the repository root.
+OLD=${OLD:-/tmp/ab/cellrt_bench.old}
+NEW=${NEW:-build/bench/cellrt_bench}
+D=docs/figures/incoherent_round12
+for k in frame ao diffuse random; do
+  python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_$k.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
+    --clock cpu --rays $k --configs embree:single embree:packet8 bvh:packet bvh:stream auto | grep '|' > $D/ab_$k.md
+done
+# Where the targets stand: the eleventh round's state script over the new binary, two runs per kind.
+for k in frame ao diffuse random; do
+  for r in 1 2; do
+    $NEW --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
+      --clock cpu --rays $k --configs embree:single embree:packet8 auto bvh bvh:paired bvh:packet kd:rec kd:branched \
+      --json $D/state_${k}_$r.json > /dev/null 2>&1
+  done
+done
+(cd $D && python3 ../incoherent_state_xeon/summary.py > summary.md)
