@@ -19,4 +19,4 @@ for k in frame ao diffuse random; do
       --json $D/state_${k}_$r.json > /dev/null 2>&1
   done
 done
-(cd $D && python3 summary.py > summary.md)
+(cd $D && python3 ../incoherent_state_xeon/summary.py > summary.md)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Issue 18's figures from run.sh's files: per ray kind and scene, each config's time (primary +
-shadow seconds; the configs the files hold) over Embree's fastest (the lesser of embree:single and embree:packet8) in the same
+shadow seconds; the configs the files hold) over Embree's fastest (the least of its configurations in the file: single rays, packets of 8 and of 16) in the same
 run, as speed ratios (Embree's time / config's time); the median of the runs, and their range."""
 import json, glob, statistics, sys
 kinds = ['frame', 'ao', 'diffuse', 'random']
@@ -20,7 +20,7 @@ for kind in kinds:
         for run in runs:
             d = {r['config']: r for r in run if r['scene'] == sc}
             t = lambda c: d[c]['primary_seconds'] + d[c]['shadow_seconds']
-            emb = min(t('embree:single'), t('embree:packet8'))
+            emb = min(t(e) for e in d if e.startswith('embree'))
             for c in configs: cells[c].append(emb / t(c))
             single.append(d['embree:single']['primary_seconds'] / d['kd:rec']['primary_seconds'])
         fmt = lambda v: f'{statistics.median(v):.2f} ({min(v):.2f}–{max(v):.2f})'
