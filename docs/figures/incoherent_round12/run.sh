@@ -20,3 +20,9 @@ for k in frame ao diffuse random; do
   done
 done
 (cd $D && python3 ../incoherent_state_xeon/summary.py > summary.md)
+# The million-triangle forest (a 75 MiB tree, beyond the 32 MiB L3), old against new:
+for k in frame ao; do
+  python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_forest_$k.json -- \
+    --scenes 'builtin:forest?tris=1000000' --size 256x256 --repeats 5 --builds 1 \
+    --clock cpu --rays $k --configs embree:packet8 embree:packet16 bvh:packet bvh:stream | grep '|' > $D/ab_forest_$k.md
+done
