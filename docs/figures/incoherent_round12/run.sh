@@ -1,6 +1,6 @@
 #!/bin/sh
 # Twelfth round (issue 18): the BVH's packets and streams fetch the children they push.
-# OLD: cellrt_bench of the commit before (git worktree add /tmp/old REV, built with -DCELLRT_CUDA=OFF
+# OLD: cellrt_bench of 03e562a, the commit before the round (git worktree add /tmp/old 03e562a, built with -DCELLRT_CUDA=OFF
 # -DCELLRT_TESTS=OFF); NEW: this commit's. Run from the repository root.
 OLD=${OLD:-/tmp/ab/cellrt_bench.old}
 NEW=${NEW:-build/bench/cellrt_bench}
