@@ -26,3 +26,10 @@ for k in frame ao; do
     --scenes 'builtin:forest?tris=1000000' --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:packet8 embree:packet16 bvh:packet bvh:stream | grep '|' > $D/ab_forest_$k.md
 done
+# The kd-tree's leaves in SIMD lanes (INCOHERENT.md, twelfth round): the branch kd-lane-leaves-prototype
+# built in /tmp/proto (-DCELLRT_CUDA=OFF -DCELLRT_TESTS=OFF), its binary without and with CELLRT_KD_LANES=1
+# (a wrapper script: CELLRT_KD_LANES=1 exec /tmp/proto/build/bench/cellrt_bench "$@"), one kd config a run
+# (the prototype's blocks belong to the last kd-tree built):
+#   for c in kd:rec kd:branched; do python3 bench/ab_compare.py /tmp/proto/build/bench/cellrt_bench lanes.sh \
+#     --rounds 3 -- --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 \
+#     --builds 1 --clock cpu --rays frame --configs embree:single $c; done
