@@ -428,6 +428,51 @@ TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     }
 }
 
+// The paired walks, the streams and the packets set their rays up eight at a time in lanes
+// (bvh_kernels.inl, prepare_rays and WatertightLanes), which must give each ray the bits of its own
+// set-up: the watertight test's axes where two or three direction components tie in magnitude
+// (max_axis takes the first), the swap where the dominant component is negative, the signs of -0 and
+// +0 components (the box test's planes). Rays with every such direction, aimed at points of the
+// scene, against brute force, in batches that leave partial groups of eight.
+TEST(Bvh, RaysSetUpInLanesKeepTiesAndSignsOfTheirDirections) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const float parts[] = {-1.f, -0.f, 0.f, 1.f, 0.5f};
+    std::vector<Ray> rays;
+    for (std::size_t t = 0; t < scene.triangles.size(); t += 151) {
+        const Triangle& tri = scene.triangles[t];
+        const Vec3 target = (tri.v0 + tri.v1 + tri.v2) * (1.f / 3.f);
+        for (float x : parts)
+            for (float y : parts)
+                for (float z : parts) {
+                    const Vec3 d{x, y, z};
+                    if (d == Vec3{}) continue;
+                    rays.push_back(Ray{target - d * 4.f, 0.f, d, kInfinity});
+                }
+    }
+    const test::ReferenceAnswers ref = test::compute_reference(scene.triangles, rays);
+    std::size_t hit = 0;
+    for (const Hit& h : ref.hits) hit += h.is_hit();
+    ASSERT_GT(hit, rays.size() / 2);  // the rays meet the scene: the leaf set-up is exercised
+    for (detail::Isa isa : detail::available_isas())
+        for (const char* traversal : {"paired", "stream", "packet"}) {
+            const std::string config = std::string("bvh:") + traversal + "+" + detail::to_string(isa);
+            const auto accel = make_accelerator(scene.triangles, parse_accel_config(config));
+            for (std::size_t batch : {std::size_t{5}, std::size_t{13}, rays.size()}) {
+                std::vector<Hit> hits(rays.size());
+                std::vector<std::uint8_t> occluded(rays.size(), 2);
+                for (std::size_t i = 0; i < rays.size(); i += batch) {
+                    const std::size_t n = std::min(batch, rays.size() - i);
+                    accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n));
+                    accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
+                }
+                std::size_t bad = 0;
+                for (std::size_t i = 0; i < rays.size(); ++i)
+                    bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
+                EXPECT_EQ(bad, 0u) << config << ", batches of " << batch;
+            }
+        }
+}
+
 // The router's streams are a view of its BVH's tree, not a second build; any other accelerator is
 // refused.
 TEST(Bvh, StreamViewSharesTheTree) {

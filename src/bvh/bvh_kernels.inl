@@ -87,6 +87,129 @@ struct LeafRay {
           kx(x * kBvhWidth), ky(y * kBvhWidth), kz(z * kBvhWidth) {}
 };
 
+// Up to eight rays of a batch in lanes, with TraversalRay's set-up (the reciprocal direction, its
+// signs, the margin) made in every ray's lane in its operations and order, so that each lane holds
+// its ray's very bits: one vector division or square root does eight rays' work, where a ray alone
+// spends seven divisions and two square roots. Lanes of invalid rays (ray.hpp) and past the batch
+// hold a finite placeholder and are not in `valid`.
+struct RayLanes {
+    F org[3], dir[3], inv[3];
+    I negative[3];  // lanes whose direction's sign bit is set on that axis: they enter a box by its hi plane
+    F tnear, tfar, margin;
+    unsigned valid;
+};
+
+inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene) {
+    static constexpr Ray kPlaceholder{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f};
+    float org[3][kLanes], dir[3][kLanes], near[kLanes], far[kLanes];
+    RayLanes l;
+    l.valid = 0;
+    for (std::size_t i = 0; i < kLanes; ++i) {
+        const bool ok = i < n && is_valid(rays[i]);
+        const Ray& r = ok ? rays[i] : kPlaceholder;
+        l.valid |= unsigned{ok} << i;
+        for (int a = 0; a < 3; ++a) {
+            org[a][i] = r.org[a];
+            dir[a][i] = r.dir[a];
+        }
+        near[i] = r.tnear;
+        far[i] = r.tfar;
+    }
+    const U no_sign = splat_u(0x7fffffffu);  // std::fabs clears the sign bit
+    F reach[3];
+    for (int a = 0; a < 3; ++a) {
+        const F o = load(org[a]), d = load(dir[a]);
+        l.org[a] = o;
+        l.dir[a] = d;
+        l.inv[a] = splat(1.f) / d;
+        l.negative[a] = reinterpret_cast<I>(d) < 0;  // the sign bit, -0 included (std::signbit)
+        const F lo = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.lo[a]) - o) & no_sign);
+        const F hi = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.hi[a]) - o) & no_sign);
+        reach[a] = select(lo < hi, hi, lo);  // std::max(lo, hi)
+    }
+    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
+    const F dir_length = sqrt_lanes(l.dir[0] * l.dir[0] + l.dir[1] * l.dir[1] + l.dir[2] * l.dir[2]);
+    l.margin = splat(kMarginScale) * reach_length / dir_length;
+    l.tnear = load(near);
+    l.tfar = load(far);
+    return l;
+}
+
+// A ray as the node and leaf tests read it, in one cache line: the box test's origin, reciprocal
+// direction, tnear and margin, and the watertight test's origin in its axis order and shear.
+struct alignas(64) PreparedRay {
+    float org[3], tnear;
+    float inv[3], margin;
+    float leaf_org[3];  // the origin in the watertight test's axis order (kx, ky, kz)
+    float shear[3];     // sx, sy, sz
+    std::uint32_t code; // bits 0-2: the direction's sign bits (x, y, z); 3-4: kx; 5-6: ky; 7-8: kz
+
+    unsigned octant() const { return code & 7u; }
+    BoxRay box() const { return BoxRay(org, inv, code, tnear, margin); }
+    LeafRay leaf() const {
+        return LeafRay(leaf_org, shear, static_cast<int>(code >> 3 & 3u), static_cast<int>(code >> 5 & 3u),
+                       static_cast<int>(code >> 7 & 3u));
+    }
+};
+static_assert(sizeof(PreparedRay) == 64, "a prepared ray is one cache line");
+
+// The lane of each ray's axis k (0, 1 or 2) of v.
+inline F pick_axis(const F (&v)[3], I k) { return select(k == 0, v[0], select(k == 1, v[1], v[2])); }
+
+// WatertightRay's set-up (triangle.hpp) in lanes, in its operations and order: each lane's axes,
+// origin in their order, and shear are its ray's.
+struct WatertightLanes {
+    F org[3], shear[3];  // the origin in the axis order (kx, ky, kz); sx, sy, sz
+    I kx, ky, kz;
+
+    explicit WatertightLanes(const RayLanes& l) {
+        const U no_sign = splat_u(0x7fffffffu);
+        F m[3];
+        for (int a = 0; a < 3; ++a) m[a] = reinterpret_cast<F>(reinterpret_cast<U>(l.dir[a]) & no_sign);
+        // max_axis (vec.hpp), its ties included; then kx and ky after kz, swapped where d[kz] < 0.
+        kz = select(m[0] >= m[1], select(m[0] >= m[2], splat_i(0), splat_i(2)),
+                    select(m[1] >= m[2], splat_i(1), splat_i(2)));
+        const I x = select(kz == 2, splat_i(0), kz + 1);
+        const I y = select(x == 2, splat_i(0), x + 1);
+        const F d_kz = pick_axis(l.dir, kz);
+        const I swap = d_kz < 0.f;
+        kx = select(swap, y, x);
+        ky = select(swap, x, y);
+        shear[0] = pick_axis(l.dir, kx) / d_kz;
+        shear[1] = pick_axis(l.dir, ky) / d_kz;
+        shear[2] = splat(1.f) / d_kz;
+        org[0] = pick_axis(l.org, kx);
+        org[1] = pick_axis(l.org, ky);
+        org[2] = pick_axis(l.org, kz);
+    }
+    // Lane i's ray as the leaf test reads it.
+    LeafRay leaf(int i) const {
+        const float o[3] = {org[0][i], org[1][i], org[2][i]}, s[3] = {shear[0][i], shear[1][i], shear[2][i]};
+        return LeafRay(o, s, kx[i], ky[i], kz[i]);
+    }
+};
+
+// Rays [0, n) (n <= kLanes) of a batch prepared in lanes (load_ray_lanes, WatertightLanes), written
+// to out[0, n). Returns the lanes of valid rays.
+inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, PreparedRay* out) {
+    const RayLanes l = load_ray_lanes(rays, n, scene);
+    const WatertightLanes w(l);
+    const I code = (l.negative[0] & 1) | (l.negative[1] & 2) | (l.negative[2] & 4) | w.kx << 3 | w.ky << 5 | w.kz << 7;
+    for (std::size_t i = 0; i < n; ++i) {
+        PreparedRay& r = out[i];
+        for (int a = 0; a < 3; ++a) {
+            r.org[a] = l.org[a][i];
+            r.inv[a] = l.inv[a][i];
+            r.leaf_org[a] = w.org[a][i];
+            r.shear[a] = w.shear[a][i];
+        }
+        r.tnear = l.tnear[i];
+        r.margin = l.margin[i];
+        r.code = static_cast<std::uint32_t>(code[i]);
+    }
+    return l.valid;
+}
+
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
 // triangle, with t, u, v.
 inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u, F& v) {
@@ -363,17 +486,25 @@ void paired_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, A
     const BvhNode* nodes = tree.nodes.data();
     const BvhLeaf* leaves = tree.leaves.data();
     BvhStacks<Query> stack_a, stack_b;
+    // The rays are set up eight at a time in lanes (prepare_rays), as the walks reach them.
+    PreparedRay prepared[kLanes];
+    unsigned prepared_valid = 0;
     std::size_t next = 0;
     // The batch's next valid ray, answering the invalid ones on the way; kNone when none is left.
     const auto take = [&]() {
-        for (; next < rays.size(); ++next)
-            if (is_valid(rays[next])) return next++;
-            else answer(next, static_cast<const Query*>(nullptr), BvhStep::done);
+        for (; next < rays.size(); ++next) {
+            if (next % kLanes == 0)
+                prepared_valid = prepare_rays(&rays[next], std::min<std::size_t>(kLanes, rays.size() - next),
+                                              tree.bounds, prepared);
+            if (prepared_valid >> next % kLanes & 1) return next++;
+            answer(next, static_cast<const Query*>(nullptr), BvhStep::done);
+        }
         return kNone;
     };
+    // The walk of the ray take() returned last.
     const auto walk = [&](std::size_t i) {
-        const TraversalRay r(rays[i], tree.bounds);
-        return Walk{BoxRay(r), LeafRay(r.watertight), Query(r)};
+        const PreparedRay& r = prepared[i % kLanes];
+        return Walk{r.box(), r.leaf(), Query(r.tnear, rays[i].tfar, r.margin)};
     };
     // The walk left when the batch runs out goes on alone.
     const auto finish = [&](std::size_t i, Walk& w, std::uint32_t word, int size, BvhStacks<Query>& st) {

@@ -29,16 +29,9 @@ inline constexpr int kPacketRays = kLanes;
 template <class Query>
 inline constexpr int kPacketSingleBelow = Query::kAnyHit ? 3 : 1;
 
-// A packet's rays as the box tests read them, one ray per lane.
-struct PacketRays {
-    F org[3], inv[3];
-    I negative[3];  // lanes whose direction's sign bit is set on that axis: they enter a box by its hi plane
-    F tnear, margin;
-};
-
 // The packet's rays that meet child `k` of `node` within [tnear - margin, cull], as lane bits, with
 // each one's entry distance: meet_children's test of that child, in every ray's lane.
-inline unsigned packet_meets(const BvhNode& node, int k, const PacketRays& p, F cull, F& entry) {
+inline unsigned packet_meets(const BvhNode& node, int k, const RayLanes& p, F cull, F& entry) {
     F enter = p.tnear, leave = splat(kInfinity);
     for (int a = 0; a < 3; ++a) {
         const F to_lo = (splat(node.lo[a][k]) - p.org[a]) * p.inv[a];
@@ -57,60 +50,24 @@ struct PacketFrame {
     float entry;
 };
 
-// The batch's rays [0, n) (n <= kPacketRays) in lanes: TraversalRay's set-up (the reciprocal
-// direction, its signs, the margin) in every ray's lane, in the same operations and order, so that
-// each lane holds its ray's very bits; its tfar in `tfar`. Returns the lanes of valid rays; the
-// others (invalid rays, lanes past n) hold a finite placeholder.
-inline unsigned load_packet(const Ray* rays, std::size_t n, const Box3& scene, PacketRays& p, F& tfar) {
-    static constexpr Ray kPlaceholder{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f};
-    float org[3][kPacketRays], dir[3][kPacketRays], near[kPacketRays], far[kPacketRays];
-    unsigned valid = 0;
-    for (std::size_t i = 0; i < kPacketRays; ++i) {
-        const bool ok = i < n && is_valid(rays[i]);
-        const Ray& r = ok ? rays[i] : kPlaceholder;
-        valid |= unsigned{ok} << i;
-        for (int a = 0; a < 3; ++a) {
-            org[a][i] = r.org[a];
-            dir[a][i] = r.dir[a];
-        }
-        near[i] = r.tnear;
-        far[i] = r.tfar;
-    }
-    const U no_sign = splat_u(0x7fffffffu);  // std::fabs clears the sign bit
-    F d[3], reach[3];
-    for (int a = 0; a < 3; ++a) {
-        const F o = load(org[a]);
-        d[a] = load(dir[a]);
-        p.org[a] = o;
-        p.inv[a] = splat(1.f) / d[a];
-        p.negative[a] = reinterpret_cast<I>(d[a]) < 0;  // the sign bit, -0 included (std::signbit)
-        const F lo = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.lo[a]) - o) & no_sign);
-        const F hi = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.hi[a]) - o) & no_sign);
-        reach[a] = select(lo < hi, hi, lo);  // std::max(lo, hi)
-    }
-    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
-    const F dir_length = sqrt_lanes(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    p.margin = splat(kMarginScale) * reach_length / dir_length;
-    p.tnear = load(near);
-    tfar = load(far);
-    return valid;
-}
-
 // One packet through the tree: the batch's rays [0, kPacketRays) in `p`, `rays` the lanes of valid
-// ones, each lane's query at its index of `q`. A ray's LeafRay is made when it first reaches a leaf
-// (a camera ray that misses the object never does). Returns the rays of `rays` not answered: an
-// any-hit query's misses.
+// ones, each lane's query at its index of `q`. Returns the rays of `rays` not answered: an any-hit
+// query's misses.
 template <class Query, class Counters>
-unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const Ray* batch, const PacketRays& p, Query* q,
+unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLanes& p, Query* q,
                       unsigned rays, Counters& c) {
     constexpr bool kAny = Query::kAnyHit;
     F cull;
     for (int i = 0; i < kPacketRays; ++i) cull[i] = rays >> i & 1 ? q[i].cull_t() : -kInfinity;
+    // The leaf test's set-up, made in lanes for the whole packet when its first ray reaches a leaf
+    // (a camera packet that misses the object never does), and then each ray's LeafRay from its lane.
+    std::optional<WatertightLanes> watertight;
     LeafRay leaf_rays[kPacketRays];
     unsigned leaf_made = 0;
     const auto leaf_ray = [&](int i) -> const LeafRay& {
         if (!(leaf_made >> i & 1)) {
-            leaf_rays[i] = LeafRay(WatertightRay(batch[i]));
+            if (!watertight) watertight.emplace(p);
+            leaf_rays[i] = watertight->leaf(i);
             leaf_made |= 1u << i;
         }
         return leaf_rays[i];
@@ -208,15 +165,14 @@ void packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Answ
     with_counters(counters, rays.size(), [&](auto& count) {
         for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
             const std::size_t n = std::min<std::size_t>(kPacketRays, rays.size() - first);
-            PacketRays p;
-            F tfar;
-            const unsigned valid = load_packet(&rays[first], n, tree.bounds, p, tfar);
+            const RayLanes p = load_ray_lanes(&rays[first], n, tree.bounds);
+            const unsigned valid = p.valid;
             const auto make = [&]<std::size_t... L>(std::index_sequence<L...>) {
-                return std::array<Query, kPacketRays>{Query(p.tnear[L], tfar[L], p.margin[L])...};
+                return std::array<Query, kPacketRays>{Query(p.tnear[L], p.tfar[L], p.margin[L])...};
             };
             std::array<Query, kPacketRays> q = make(std::make_index_sequence<kPacketRays>());
             const unsigned missed =
-                valid ? trace_packet(tree.nodes.data(), tree.leaves.data(), &rays[first], p, q.data(), valid, count)
+                valid ? trace_packet(tree.nodes.data(), tree.leaves.data(), p, q.data(), valid, count)
                       : 0u;
             for (std::size_t i = 0; i < n; ++i) {
                 if constexpr (Query::kAnyHit) out[first + i] = (valid & ~missed) >> i & 1;

@@ -26,40 +26,6 @@
 // 2026-12-02, docs/INCOHERENT.md "Ray streams": 0 to 4 lose on diffuse bounces, 8 and 16 win on AO).
 inline constexpr std::uint32_t kSingleBelow = 8;
 
-// A ray of a stream as the node and leaf tests read it: one cache line.
-struct alignas(64) StreamRay {
-    float org[3], tnear;
-    float inv[3], margin;
-    float leaf_org[3];  // the origin in the watertight test's axis order (kx, ky, kz)
-    float shear[3];     // sx, sy, sz
-    std::uint32_t code; // bits 0-2: the direction's sign bits (x, y, z); 3-4: kx; 5-6: ky; 7-8: kz
-
-    void set(const TraversalRay& r) {
-        const WatertightRay& w = r.watertight;
-        for (int a = 0; a < 3; ++a) {
-            org[a] = r.org[a];
-            inv[a] = r.inv_dir[a];
-        }
-        tnear = r.tnear;
-        margin = r.margin;
-        leaf_org[0] = w.org[w.kx];
-        leaf_org[1] = w.org[w.ky];
-        leaf_org[2] = w.org[w.kz];
-        shear[0] = w.sx;
-        shear[1] = w.sy;
-        shear[2] = w.sz;
-        code = octant_bits(r) | std::uint32_t(w.kx) << 3 |
-               std::uint32_t(w.ky) << 5 | std::uint32_t(w.kz) << 7;
-    }
-    unsigned octant() const { return code & 7u; }
-    BoxRay box() const { return BoxRay(org, inv, code, tnear, margin); }
-    LeafRay leaf() const {
-        return LeafRay(leaf_org, shear, static_cast<int>(code >> 3 & 3u), static_cast<int>(code >> 5 & 3u),
-                       static_cast<int>(code >> 7 & 3u));
-    }
-};
-static_assert(sizeof(StreamRay) == 64, "a stream's ray is one cache line");
-
 // A ray of a node's stream and the distance at which it enters that node.
 struct StreamEntry {
     std::uint32_t ray;
@@ -74,7 +40,7 @@ struct StreamFrame {
 // What a batch's streams need, kept per thread and reused (grown, never shrunk), so that a batch
 // allocates nothing once a thread has traced one as large.
 struct StreamScratch {
-    std::vector<StreamRay> rays;        // the batch's valid rays, by octant
+    std::vector<PreparedRay> rays;      // the batch's valid rays, by octant
     std::vector<std::uint32_t> index;   // each one's place in the batch
     std::vector<ClosestHit> closest;    // their queries
     std::vector<AnyHit> any;
@@ -96,7 +62,7 @@ template <class Query, class Counters>
 void trace_stream(const BvhNode* nodes, const BvhLeaf* leaves, StreamScratch& s, Query* queries, std::uint32_t first,
                   std::uint32_t count, unsigned order, Counters& c) {
     constexpr bool kAny = Query::kAnyHit;
-    const StreamRay* rays = s.rays.data();
+    const PreparedRay* rays = s.rays.data();
     std::uint8_t* done = s.done.data();
     if (s.arena.size() < std::size_t{count} * kBvhWidth) s.arena.resize(std::size_t{count} * kBvhWidth);
     for (std::uint32_t i = 0; i < count; ++i) s.arena[i] = {first + i, -kInfinity};
@@ -244,14 +210,17 @@ std::uint32_t prepare_stream(const BvhTree& tree, std::span<const Ray> rays, Str
         ends[o] = sum;
     }
     std::uint32_t valid = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!is_valid(rays[i])) continue;
-        const TraversalRay r(rays[i], tree.bounds);
-        const std::uint32_t k = by_octant ? at[octant_bits(r)]++ : valid;
-        ++valid;
-        s.rays[k].set(r);
-        s.index[k] = static_cast<std::uint32_t>(i);
-        queries[k] = Query(r);
+    PreparedRay group[kLanes];
+    for (std::size_t first = 0; first < n; first += kLanes) {
+        const std::size_t m = std::min<std::size_t>(kLanes, n - first);
+        for (unsigned lanes = prepare_rays(&rays[first], m, tree.bounds, group); lanes; lanes &= lanes - 1) {
+            const unsigned i = static_cast<unsigned>(__builtin_ctz(lanes));
+            const std::uint32_t k = by_octant ? at[group[i].octant()]++ : valid;
+            ++valid;
+            s.rays[k] = group[i];
+            s.index[k] = static_cast<std::uint32_t>(first + i);
+            queries[k] = Query(group[i].tnear, rays[first + i].tfar, group[i].margin);
+        }
     }
     if (!by_octant) ends[0] = valid;
     return valid;
