@@ -15,6 +15,8 @@
 
 static_assert(kLanes == kBvhWidth, "one lane per child and per triangle");
 
+#include "simd/ray_lanes.inl"
+
 // Eight floats or words read in place, at any alignment: one vector load (a memcpy into the vector
 // type compiles, under GCC 12, to a load, a store to the stack and a load back).
 typedef float FRow __attribute__((vector_size(4 * kLanes), aligned(4), may_alias));
@@ -87,54 +89,6 @@ struct LeafRay {
           kx(x * kBvhWidth), ky(y * kBvhWidth), kz(z * kBvhWidth) {}
 };
 
-// Up to eight rays of a batch in lanes, with TraversalRay's set-up (the reciprocal direction, its
-// signs, the margin) made in every ray's lane in its operations and order, so that each lane holds
-// its ray's very bits: one vector division or square root does eight rays' work, where a ray alone
-// spends seven divisions and two square roots. Lanes of invalid rays (ray.hpp) and past the batch
-// hold a finite placeholder and are not in `valid`.
-struct RayLanes {
-    F org[3], dir[3], inv[3];
-    I negative[3];  // lanes whose direction's sign bit is set on that axis: they enter a box by its hi plane
-    F tnear, tfar, margin;
-    unsigned valid;
-};
-
-inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene) {
-    static constexpr Ray kPlaceholder{Vec3{0.f, 0.f, 0.f}, 0.f, Vec3{1.f, 1.f, 1.f}, 0.f};
-    float org[3][kLanes], dir[3][kLanes], near[kLanes], far[kLanes];
-    RayLanes l;
-    l.valid = 0;
-    for (std::size_t i = 0; i < kLanes; ++i) {
-        const bool ok = i < n && is_valid(rays[i]);
-        const Ray& r = ok ? rays[i] : kPlaceholder;
-        l.valid |= unsigned{ok} << i;
-        for (int a = 0; a < 3; ++a) {
-            org[a][i] = r.org[a];
-            dir[a][i] = r.dir[a];
-        }
-        near[i] = r.tnear;
-        far[i] = r.tfar;
-    }
-    const U no_sign = splat_u(0x7fffffffu);  // std::fabs clears the sign bit
-    F reach[3];
-    for (int a = 0; a < 3; ++a) {
-        const F o = load(org[a]), d = load(dir[a]);
-        l.org[a] = o;
-        l.dir[a] = d;
-        l.inv[a] = splat(1.f) / d;
-        l.negative[a] = reinterpret_cast<I>(d) < 0;  // the sign bit, -0 included (std::signbit)
-        const F lo = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.lo[a]) - o) & no_sign);
-        const F hi = reinterpret_cast<F>(reinterpret_cast<U>(splat(scene.hi[a]) - o) & no_sign);
-        reach[a] = select(lo < hi, hi, lo);  // std::max(lo, hi)
-    }
-    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
-    const F dir_length = sqrt_lanes(l.dir[0] * l.dir[0] + l.dir[1] * l.dir[1] + l.dir[2] * l.dir[2]);
-    l.margin = splat(kMarginScale) * reach_length / dir_length;
-    l.tnear = load(near);
-    l.tfar = load(far);
-    return l;
-}
-
 // A ray as the node and leaf tests read it, in one cache line: the box test's origin, reciprocal
 // direction, tnear and margin, and the watertight test's origin in its axis order and shear.
 struct alignas(64) PreparedRay {
@@ -153,44 +107,14 @@ struct alignas(64) PreparedRay {
 };
 static_assert(sizeof(PreparedRay) == 64, "a prepared ray is one cache line");
 
-// The lane of each ray's axis k (0, 1 or 2) of v.
-inline F pick_axis(const F (&v)[3], I k) { return select(k == 0, v[0], select(k == 1, v[1], v[2])); }
+// Lane i's ray of `w` as the leaf test reads it.
+inline LeafRay leaf_ray_of_lane(const WatertightLanes& w, int i) {
+    const float o[3] = {w.org[0][i], w.org[1][i], w.org[2][i]}, s[3] = {w.shear[0][i], w.shear[1][i], w.shear[2][i]};
+    return LeafRay(o, s, w.kx[i], w.ky[i], w.kz[i]);
+}
 
-// WatertightRay's set-up (triangle.hpp) in lanes, in its operations and order: each lane's axes,
-// origin in their order, and shear are its ray's.
-struct WatertightLanes {
-    F org[3], shear[3];  // the origin in the axis order (kx, ky, kz); sx, sy, sz
-    I kx, ky, kz;
-
-    explicit WatertightLanes(const RayLanes& l) {
-        const U no_sign = splat_u(0x7fffffffu);
-        F m[3];
-        for (int a = 0; a < 3; ++a) m[a] = reinterpret_cast<F>(reinterpret_cast<U>(l.dir[a]) & no_sign);
-        // max_axis (vec.hpp), its ties included; then kx and ky after kz, swapped where d[kz] < 0.
-        kz = select(m[0] >= m[1], select(m[0] >= m[2], splat_i(0), splat_i(2)),
-                    select(m[1] >= m[2], splat_i(1), splat_i(2)));
-        const I x = select(kz == 2, splat_i(0), kz + 1);
-        const I y = select(x == 2, splat_i(0), x + 1);
-        const F d_kz = pick_axis(l.dir, kz);
-        const I swap = d_kz < 0.f;
-        kx = select(swap, y, x);
-        ky = select(swap, x, y);
-        shear[0] = pick_axis(l.dir, kx) / d_kz;
-        shear[1] = pick_axis(l.dir, ky) / d_kz;
-        shear[2] = splat(1.f) / d_kz;
-        org[0] = pick_axis(l.org, kx);
-        org[1] = pick_axis(l.org, ky);
-        org[2] = pick_axis(l.org, kz);
-    }
-    // Lane i's ray as the leaf test reads it.
-    LeafRay leaf(int i) const {
-        const float o[3] = {org[0][i], org[1][i], org[2][i]}, s[3] = {shear[0][i], shear[1][i], shear[2][i]};
-        return LeafRay(o, s, kx[i], ky[i], kz[i]);
-    }
-};
-
-// Rays [0, n) (n <= kLanes) of a batch prepared in lanes (load_ray_lanes, WatertightLanes), written
-// to out[0, n). Returns the lanes of valid rays.
+// Rays [0, n) (n <= kLanes) of a batch prepared in lanes (simd/ray_lanes.inl), written to
+// out[0, n). Returns the lanes of valid rays, as bits.
 inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, PreparedRay* out) {
     const RayLanes l = load_ray_lanes(rays, n, scene);
     const WatertightLanes w(l);
@@ -207,7 +131,7 @@ inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, 
         r.margin = l.margin[i];
         r.code = static_cast<std::uint32_t>(code[i]);
     }
-    return l.valid;
+    return bits(l.valid);
 }
 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their

@@ -67,7 +67,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
     const auto leaf_ray = [&](int i) -> const LeafRay& {
         if (!(leaf_made >> i & 1)) {
             if (!watertight) watertight.emplace(p);
-            leaf_rays[i] = watertight->leaf(i);
+            leaf_rays[i] = leaf_ray_of_lane(*watertight, i);
             leaf_made |= 1u << i;
         }
         return leaf_rays[i];
@@ -166,7 +166,7 @@ void packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Answ
         for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
             const std::size_t n = std::min<std::size_t>(kPacketRays, rays.size() - first);
             const RayLanes p = load_ray_lanes(&rays[first], n, tree.bounds);
-            const unsigned valid = p.valid;
+            const unsigned valid = bits(p.valid);
             const auto make = [&]<std::size_t... L>(std::index_sequence<L...>) {
                 return std::array<Query, kPacketRays>{Query(p.tnear[L], p.tfar[L], p.margin[L])...};
             };

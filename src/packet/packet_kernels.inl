@@ -21,6 +21,8 @@
 //
 // No include guard: included once per instruction set.
 
+#include "simd/ray_lanes.inl"
+
 // One SIMD packet: kLanes rays as a structure of arrays, what the traversal and the watertight test
 // need per lane.
 struct Lanes {
@@ -39,67 +41,34 @@ struct Lanes {
     int shared = -1;  // the permutation all valid lanes share, or -1
 };
 
-inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }
-inline F max_lanes(F a, F b) { return select(a < b, b, a); }  // std::max's choice, lane by lane
 inline F pick(I is0, I is1, F x, F y, F z) { return select(is0, x, select(is1, y, z)); }
 
-// Loads n <= kLanes rays and computes, lane by lane, every per-ray constant of the single-ray kernels
-// (TraversalRay and WatertightRay) with the same operations, so lanes carry the same bits.
+// Loads n <= kLanes rays with every per-ray constant of the single-ray kernels (TraversalRay and
+// WatertightRay) made lane by lane (simd/ray_lanes.inl), so lanes carry the same bits.
 inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
+    const RayLanes R = load_ray_lanes(rays, static_cast<std::size_t>(n), scene_box);
+    const WatertightLanes W(R);
     Lanes L;
     L.count = n;
-    F o[3], d[3], tnear = splat(0.f), tfar = splat(0.f);
-    for (int a = 0; a < 3; ++a) o[a] = d[a] = splat(0.f);
-    I loaded = splat_i(0);
-    for (int i = 0; i < n; ++i) {
-        for (int a = 0; a < 3; ++a) o[a][i] = rays[i].org[a], d[a][i] = rays[i].dir[a];
-        tnear[i] = rays[i].tnear;
-        tfar[i] = rays[i].tfar;
-        loaded[i] = -1;
-    }
-    // is_valid (ray.hpp): finite origin and direction (x - x is 0 only for finite x), a direction
-    // that is not zero, tnear <= tfar, no NaN bound.
-    I finite = loaded;
-    for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
-    L.valid = finite & ~((d[0] == 0.f) & (d[1] == 0.f) & (d[2] == 0.f)) & ~(tnear > tfar) & (tnear == tnear) &
-              (tfar == tfar);
-    // Invalid lanes get a harmless ray, so that nothing below divides by zero or meets a NaN.
     for (int a = 0; a < 3; ++a) {
-        o[a] = select(L.valid, o[a], splat(0.f));
-        d[a] = select(L.valid, d[a], splat(1.f));
+        L.org[a] = R.org[a];
+        L.inv[a] = R.inv[a];
+        L.neg[a] = R.negative[a];
     }
-    for (int a = 0; a < 3; ++a) {
-        L.org[a] = o[a];
-        L.inv[a] = splat(1.f) / d[a];
-        L.neg[a] = (I)d[a] < 0;  // the sign bit, -0 included
+    L.tnear = R.tnear;
+    L.tfar = R.tfar;
+    L.margin = R.margin;
+    L.valid = R.valid;
+    L.sx = W.shear[0];
+    L.sy = W.shear[1];
+    L.sz = W.shear[2];
+    L.perm = W.kz + W.kz + (W.swapped & splat_i(1));
+    const I role[3] = {W.kx, W.ky, W.kz};
+    for (int r = 0; r < 3; ++r) {
+        L.is_x[r] = role[r] == 0;
+        L.is_y[r] = role[r] == 1;
+        L.role_org[r] = W.org[r];
     }
-    L.tnear = tnear;
-    L.tfar = tfar;
-    F reach[3];
-    for (int a = 0; a < 3; ++a)
-        reach[a] = max_lanes(abs_lanes(splat(scene_box.lo[a]) - o[a]), abs_lanes(splat(scene_box.hi[a]) - o[a]));
-    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
-    const F dir_length = sqrt_lanes(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    L.margin = splat(kMarginScale) * reach_length / dir_length;
-    // WatertightRay: kz the largest |d| (ties to the lower axis), kx and ky the next ones, swapped
-    // when d[kz] is negative.
-    const F m0 = abs_lanes(d[0]), m1 = abs_lanes(d[1]), m2 = abs_lanes(d[2]);
-    const I z0 = (m0 >= m1) & (m0 >= m2), z1 = ~(m0 >= m1) & (m1 >= m2);
-    const F dz = pick(z0, z1, d[0], d[1], d[2]);
-    const I swap = dz < 0.f;
-    // kx = kz + 1 and ky = kz + 2 (mod 3), or the other way round when swapped.
-    const F d_next = pick(z0, z1, d[1], d[2], d[0]), d_after = pick(z0, z1, d[2], d[0], d[1]);
-    L.sx = select(swap, d_after, d_next) / dz;
-    L.sy = select(swap, d_next, d_after) / dz;
-    L.sz = splat(1.f) / dz;
-    L.perm = select(z0, splat_i(0), select(z1, splat_i(2), splat_i(4))) + (swap & splat_i(1));
-    const I z2 = ~z0 & ~z1;
-    // The axis after kz is y when kz = x, z when kz = y, x when kz = z; the one after that follows.
-    const I next_x = z2, next_y = z0, after_x = z1, after_y = z2;
-    L.is_x[0] = select(swap, after_x, next_x), L.is_y[0] = select(swap, after_y, next_y);
-    L.is_x[1] = select(swap, next_x, after_x), L.is_y[1] = select(swap, next_y, after_y);
-    L.is_x[2] = z0, L.is_y[2] = z1;
-    for (int r = 0; r < 3; ++r) L.role_org[r] = pick(L.is_x[r], L.is_y[r], o[0], o[1], o[2]);
     const unsigned valid_bits = bits(L.valid);
     if (valid_bits) {
         const int p = L.perm[__builtin_ctz(valid_bits)];

@@ -1,0 +1,82 @@
+// A batch's rays in SIMD lanes, each with the single-ray kernels' set-up (TraversalRay,
+// kernel/traversal.hpp, and WatertightRay, triangle.hpp) made in its lane with their operations in
+// their order, so that each lane holds its ray's very bits: one vector division or square root does
+// the work of kLanes rays' (seven divisions and two square roots a ray), and the scalar set-up's
+// branches (the dominant axis and its sign, mispredicted on incoherent rays) become selects. Used by
+// the SIMD packets (packet/packet_kernels.inl) and by the wide BVH's packets, paired walks and
+// streams (bvh/bvh_kernels.inl).
+//
+// No include guard: included after simd/lanes.inl, once per namespace of lanes.
+
+inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }  // std::fabs clears the sign bit
+inline F max_lanes(F a, F b) { return select(a < b, b, a); }        // std::max's choice, lane by lane
+
+// TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes). Lanes of invalid rays (ray.hpp) and
+// lanes past n hold a harmless ray (origin 0, direction (1, 1, 1)) and are not in `valid`.
+struct RayLanes {
+    F org[3], dir[3], inv[3];
+    I negative[3];  // the direction's sign bit per axis, -0 included (std::signbit): enters by the hi plane
+    F tnear, tfar, margin;
+    I valid;
+};
+
+inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene) {
+    RayLanes L;
+    F o[3], d[3];
+    for (int a = 0; a < 3; ++a) o[a] = d[a] = splat(0.f);
+    L.tnear = L.tfar = splat(0.f);
+    I loaded = splat_i(0);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int a = 0; a < 3; ++a) o[a][i] = rays[i].org[a], d[a][i] = rays[i].dir[a];
+        L.tnear[i] = rays[i].tnear;
+        L.tfar[i] = rays[i].tfar;
+        loaded[i] = -1;
+    }
+    // is_valid (ray.hpp): finite origin and direction (x - x is 0 only for finite x), a direction
+    // that is not zero, tnear <= tfar, no NaN bound.
+    I finite = loaded;
+    for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
+    L.valid = finite & ~((d[0] == 0.f) & (d[1] == 0.f) & (d[2] == 0.f)) & ~(L.tnear > L.tfar) &
+              (L.tnear == L.tnear) & (L.tfar == L.tfar);
+    F reach[3];
+    for (int a = 0; a < 3; ++a) {
+        L.org[a] = select(L.valid, o[a], splat(0.f));
+        L.dir[a] = select(L.valid, d[a], splat(1.f));
+        L.inv[a] = splat(1.f) / L.dir[a];
+        L.negative[a] = (I)L.dir[a] < 0;
+        reach[a] = max_lanes(abs_lanes(splat(scene.lo[a]) - L.org[a]), abs_lanes(splat(scene.hi[a]) - L.org[a]));
+    }
+    const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
+    const F dir_length = sqrt_lanes(L.dir[0] * L.dir[0] + L.dir[1] * L.dir[1] + L.dir[2] * L.dir[2]);
+    L.margin = splat(kMarginScale) * reach_length / dir_length;
+    return L;
+}
+
+// The lane of each ray's axis k (0, 1 or 2) of v.
+inline F pick_axis(const F (&v)[3], I k) { return select(k == 0, v[0], select(k == 1, v[1], v[2])); }
+
+// WatertightRay's set-up of the rays in `L`: kz the axis of the largest |d| (ties to the lower axis,
+// as max_axis), kx and ky the next two, swapped where d[kz] is negative; the shear and the origin in
+// that axis order.
+struct WatertightLanes {
+    F org[3], shear[3];  // the origin's kx, ky, kz coordinates; sx, sy, sz
+    I kx, ky, kz;
+    I swapped;
+
+    explicit WatertightLanes(const RayLanes& L) {
+        const F m0 = abs_lanes(L.dir[0]), m1 = abs_lanes(L.dir[1]), m2 = abs_lanes(L.dir[2]);
+        kz = select(m0 >= m1, select(m0 >= m2, splat_i(0), splat_i(2)), select(m1 >= m2, splat_i(1), splat_i(2)));
+        const I next = select(kz == 2, splat_i(0), kz + 1);
+        const I after = select(next == 2, splat_i(0), next + 1);
+        const F d_kz = pick_axis(L.dir, kz);
+        swapped = d_kz < 0.f;
+        kx = select(swapped, after, next);
+        ky = select(swapped, next, after);
+        shear[0] = pick_axis(L.dir, kx) / d_kz;
+        shear[1] = pick_axis(L.dir, ky) / d_kz;
+        shear[2] = splat(1.f) / d_kz;
+        org[0] = pick_axis(L.org, kx);
+        org[1] = pick_axis(L.org, ky);
+        org[2] = pick_axis(L.org, kz);
+    }
+};
