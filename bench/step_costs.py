@@ -559,7 +559,7 @@ def main():
     ap.add_argument("--scenes-dir", default=os.path.join(ROOT, "../shared/scenes"))
     ap.add_argument("--scenes", nargs="+", default=["sponza", "sibenik", "bunny", "teapot"])
     ap.add_argument("--rays", nargs="+", default=["frame", "random", "ao", "diffuse"])
-    ap.add_argument("--configs", nargs="+", default=["kd:branched", "bvh", "kd:rec", "kd:branchless", "bih:branched"])
+    ap.add_argument("--configs", nargs="+", default=["kd:branched", "bvh:wide", "kd:rec", "kd:branchless", "bih:branched"])
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--I1", default="32768,8,64")
     ap.add_argument("--D1", default="49152,12,64")
@@ -611,7 +611,7 @@ def main():
         "cycles": "Ir + 10*(I1mr+D1mr+D1mw) + 100*(ILmr+DLmr+DLmw) + 20*(Bcm+Bim)",
         "categories": "setup, batch: per ray; node: per inner node; leaf: per leaf, its pop included; triangle: per triangle tested",
         "rows": rows, "fits": fits(results),
-        "hot_loops": {c: hot_loop(o.bench, results, c) for c in ("kd:branched", "bvh")},
+        "hot_loops": {c: hot_loop(o.bench, results, c) for c in ("kd:branched", "bvh:wide")},
     }
     os.makedirs(os.path.dirname(os.path.abspath(o.json)), exist_ok=True)
     with open(o.json, "w") as f:

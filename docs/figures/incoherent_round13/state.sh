@@ -1,6 +1,7 @@
 #!/bin/sh
 # Where issue 18's targets stand after the thirteenth round: the eleventh round's state script over this
-# round's binary, two runs per ray kind, Embree's packets of 16 among its configurations.
+# round's binary, two runs per ray kind, Embree's packets of 16 among its configurations. `bvh` there was
+# the one-ray kernel; since 2026-12-05 `bvh`'s default traversal is `paired`: rerun with `bvh:wide` in its place.
 NEW=${NEW:-build/bench/cellrt_bench}
 D=docs/figures/incoherent_round13
 for k in frame ao diffuse random; do
