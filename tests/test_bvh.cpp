@@ -384,6 +384,22 @@ TEST(Bvh, RaysAlongItsOwnBoxFaces) {
                              std::string(config) + " on its box faces");
 }
 
+// Traces `rays` through `accel` in batches of `batch`, closest and any hit, the work counted into
+// `counters` where given; returns how many rays' answers differ from `ref`.
+std::size_t differing_answers(const Accelerator& accel, std::span<const Ray> rays, const test::ReferenceAnswers& ref,
+                              std::size_t batch, TraversalCounters* counters = nullptr) {
+    std::vector<Hit> hits(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size(), 2);
+    for (std::size_t i = 0; i < rays.size(); i += batch) {
+        const std::size_t n = std::min(batch, rays.size() - i);
+        accel.intersect(rays.subspan(i, n), std::span(hits).subspan(i, n), counters);
+        accel.occluded(rays.subspan(i, n), std::span(occluded).subspan(i, n), counters);
+    }
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
+    return bad;
+}
+
 // Every traversal in batches of every size, from one ray to the whole suite in one call (the
 // streams' per-thread scratch grows and is reused; packets of eight rays and a short last one), with
 // invalid rays mixed in, on every instruction set: the brute-force answers, and every ray counted
@@ -404,18 +420,8 @@ TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
             EXPECT_EQ(accel->stats().traversal, traversal);
             for (std::size_t batch : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{7}, std::size_t{256},
                                       std::size_t{1000}, rays.size()}) {
-                std::vector<Hit> hits(rays.size());
-                std::vector<std::uint8_t> occluded(rays.size(), 2);
                 TraversalCounters counters;
-                for (std::size_t i = 0; i < rays.size(); i += batch) {
-                    const std::size_t n = std::min(batch, rays.size() - i);
-                    accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n), &counters);
-                    accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n), &counters);
-                }
-                std::size_t bad = 0;
-                for (std::size_t i = 0; i < rays.size(); ++i)
-                    bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
-                EXPECT_EQ(bad, 0u) << config << ", batches of " << batch;
+                EXPECT_EQ(differing_answers(*accel, rays, ref, batch, &counters), 0u) << config << ", batches of " << batch;
                 EXPECT_EQ(counters.rays, 2 * rays.size());
                 EXPECT_GT(counters.nodes, 0u);
                 if (traversal != std::string("wide") && traversal != std::string("paired")) continue;
@@ -458,17 +464,7 @@ TEST(Bvh, RaysSetUpInLanesKeepTiesAndSignsOfTheirDirections) {
             const std::string config = std::string("bvh:") + traversal + "+" + detail::to_string(isa);
             const auto accel = make_accelerator(scene.triangles, parse_accel_config(config));
             for (std::size_t batch : {std::size_t{5}, std::size_t{13}, rays.size()}) {
-                std::vector<Hit> hits(rays.size());
-                std::vector<std::uint8_t> occluded(rays.size(), 2);
-                for (std::size_t i = 0; i < rays.size(); i += batch) {
-                    const std::size_t n = std::min(batch, rays.size() - i);
-                    accel->intersect(std::span(rays).subspan(i, n), std::span(hits).subspan(i, n));
-                    accel->occluded(std::span(rays).subspan(i, n), std::span(occluded).subspan(i, n));
-                }
-                std::size_t bad = 0;
-                for (std::size_t i = 0; i < rays.size(); ++i)
-                    bad += !(hits[i] == ref.hits[i]) || occluded[i] != ref.occluded[i];
-                EXPECT_EQ(bad, 0u) << config << ", batches of " << batch;
+                EXPECT_EQ(differing_answers(*accel, rays, ref, batch), 0u) << config << ", batches of " << batch;
             }
         }
 }

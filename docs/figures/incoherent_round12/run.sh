@@ -10,16 +10,9 @@ for k in frame ao diffuse random; do
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:single embree:packet8 bvh:packet bvh:stream auto | grep '|' > $D/ab_$k.md
 done
-# Where the targets stand: the eleventh round's state script over the new binary, two runs per kind,
-# with Embree's packets of 16 (AVX-512 here) among its configurations.
-for k in frame ao diffuse random; do
-  for r in 1 2; do
-    $NEW --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
-      --clock cpu --rays $k --configs embree:single embree:packet8 embree:packet16 auto bvh bvh:paired bvh:packet kd:rec kd:branched \
-      --json $D/state_${k}_$r.json > /dev/null 2>&1
-  done
-done
-(cd $D && python3 ../incoherent_state_xeon/summary.py > summary.md)
+# Where the targets stand (bench/incoherent_state.sh; its `bvh:wide` was then named `bvh`), with Embree's
+# packets of 16 (AVX-512 here) among its configurations.
+bench/incoherent_state.sh $D $NEW
 # The million-triangle forest (a 75 MiB tree, beyond the 32 MiB L3), old against new:
 for k in frame ao; do
   python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_forest_$k.json -- \

@@ -8,3 +8,4 @@ for kind in frame ao diffuse random; do
       --json state_${kind}_$r.json > /dev/null 2>&1
   done
 done
+# The table (summary.md), from this folder: python3 ../../../bench/incoherent_state_table.py > summary.md

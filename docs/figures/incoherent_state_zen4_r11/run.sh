@@ -9,7 +9,7 @@ for kind in frame ao diffuse random; do
       --json state_${kind}_$r.json > /dev/null 2>&1
   done
 done
-python3 ../incoherent_state_xeon/summary.py > summary.md
+python3 ../../../bench/incoherent_state_table.py > summary.md
 # Whole frames, one and two workers (from the repository root):
 #   for s in ao diffuse; do build/bench/cellrt_scaling --scenes-dir ../shared/scenes --scenes sponza bunny \
 #     --configs embree:single embree:packet8 auto bvh:paired --dispatch pull --packets 16 --workers 1 2 \
