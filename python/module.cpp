@@ -38,16 +38,22 @@ std::string param_value(py::handle value, const std::string& name) {
 }
 
 // kind "KIND[:TRAVERSAL]", the SIMD set, the build threads, the structure's parameters and the device.
+// kind None is the library's default for the device (default_accel_config: `auto@packets=bvh` on the
+// CPU, `kd` on the GPU), to which `params` add or override parameters.
 // On the GPU (device "cuda") simd "auto" is its own one-ray-a-thread kernels, as the CLI's --device
 // cuda without --simd; any other SIMD set is refused there by the library.
 AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, py::handle params, py::handle device) {
-    const std::string spec = text(kind, "kind");
-    if (spec.find_first_of("+@") != std::string::npos)
-        throw py::value_error("kind '" + spec + "' must be KIND or KIND:TRAVERSAL; pass the SIMD set as simd= and "
-                              "parameters as params=");
-    AccelConfig c = parse_accel_config(spec);
+    const std::string place = text(device, "device");
+    AccelConfig c = default_accel_config(place);
+    if (!kind.is_none()) {
+        const std::string spec = text(kind, "kind");
+        if (spec.find_first_of("+@") != std::string::npos)
+            throw py::value_error("kind '" + spec + "' must be KIND or KIND:TRAVERSAL; pass the SIMD set as simd= "
+                                  "and parameters as params=");
+        c = parse_accel_config(spec);
+    }
     c.simd = text(simd, "simd");
-    c.device = text(device, "device");
+    c.device = place;
     if (c.device == "cuda" && c.simd == "auto") c.simd = "off";
     c.threads = small_count(threads, "threads", kMaxWorkers);
     if (!py::isinstance<py::dict>(params))
@@ -250,12 +256,13 @@ PYBIND11_MODULE(cellrt, m) {
                  const AccelConfig config = accel_config(kind, simd, threads, params, device);
                  return build(faces.is_none() ? triangle_soup(first) : indexed_triangles(first, faces), config);
              }),
-             py::arg("vertices"), py::arg("faces") = py::none(), py::kw_only(), py::arg("kind") = "kd",
+             py::arg("vertices"), py::arg("faces") = py::none(), py::kw_only(), py::arg("kind") = py::none(),
              py::arg("simd") = "auto", py::arg("threads") = 0, py::arg("params") = py::dict(),
              py::arg("device") = "cpu",
-             "Accelerator(vertices (N,3), faces (M,3), kind='kd', simd='auto', threads=0, params={}, device='cpu'), "
-             "or Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); device: 'cpu' "
-             "or 'cuda' (cellrt.device_info()); the GIL is released during the build.")
+             "Accelerator(vertices (N,3), faces (M,3), kind=None, simd='auto', threads=0, params={}, device='cpu'), "
+             "or Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); None: 'auto' "
+             "with params packets='bvh' on the CPU, 'kd' on the GPU; device: 'cpu' or 'cuda' (cellrt.device_info()); "
+             "the GIL is released during the build.")
         .def("intersect", &py_intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0,
              py::arg("tfar") = std::numeric_limits<double>::infinity(),
              "Closest hits: dict of arrays t (inf on a miss), prim (int64, -1 on a miss), u, v.")

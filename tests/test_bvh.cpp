@@ -843,14 +843,52 @@ TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
     }
     EXPECT_EQ(setting("auto@streams=off", "bvh_packets"), "on");
     EXPECT_EQ(setting("auto@bvh_packets=off", "streams"), "on");
+    // With the BVH's own packets for coherent batches, they are the first path, not a fourth.
+    EXPECT_EQ(setting("auto", "packets"), "kd");
+    EXPECT_EQ(setting("auto@packets=bvh", "bvh_packets"), "off");
+    EXPECT_EQ(setting("auto@packets=bvh", "streams"), "on");
 }
 
-// While it learns, the route gives runs of batches to each of the four paths, with the same
-// answers, and the work counted is one tracing per ray whichever path answered.
-TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
+// A caller who names no configuration (the C API's NULL, Python's kind=None) gets the route over one
+// BVH on the CPU, and the kd-tree on the GPU, which traces the trees only.
+TEST(Routed, IsTheDefaultOnTheCpu) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=200");
+    const AccelConfig cpu = default_accel_config();
+    EXPECT_EQ(cpu.kind, "auto");
+    EXPECT_EQ(cpu.device, "cpu");
+    const AccelStats s = make_accelerator(scene.triangles, cpu)->stats();
+    EXPECT_EQ(s.name, "auto");
+    EXPECT_EQ(s.setting("packets"), "bvh");
+    const AccelConfig gpu = default_accel_config("cuda");
+    EXPECT_EQ(gpu.kind, "kd");
+    EXPECT_EQ(gpu.simd, "off");
+    EXPECT_EQ(gpu.device, "cuda");
+}
+
+// `packets=bvh` builds one tree for every path: the route's memory is the BVH's, and its packets are
+// the BVH's eight rays at a time.
+TEST(Routed, BvhPacketsRouteHoldsOneTree) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
+    const AccelStats one = make_accelerator(scene.triangles, AccelConfig{"bvh"})->stats();
+    const AccelStats routed = make_accelerator(scene.triangles, parse_accel_config("auto@packets=bvh"))->stats();
+    const AccelStats two = make_accelerator(scene.triangles, parse_accel_config("auto"))->stats();
+    EXPECT_EQ(routed.memory_bytes, one.memory_bytes);
+    EXPECT_GT(two.memory_bytes, one.memory_bytes);  // the kd-tree and the BVH
+    EXPECT_EQ(routed.simd_lanes, detail::kBvhWidth);
+    EXPECT_EQ(make_accelerator(scene.triangles, parse_accel_config("bvh:packet"))->stats().simd_lanes, detail::kBvhWidth);
+    EXPECT_EQ(one.simd_lanes, 0);
+}
+
+// While it learns, the route gives runs of batches to each of its paths (four; three when the
+// BVH's packets are its packets), with the same answers, and the work counted is one tracing per
+// ray whichever path answered.
+class RoutedPaths : public ::testing::TestWithParam<std::pair<std::string, std::vector<std::string>>> {};
+
+TEST_P(RoutedPaths, StreamedBatchesAnswerAsBruteForce) {
+    const auto& [spec, names] = GetParam();
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const test::ReferenceAnswers& ref = test::cached_reference("builtin:spheres?tris=3000", scene.triangles);
-    const auto routed = make_accelerator(scene.triangles, parse_accel_config("auto"));
+    const auto routed = make_accelerator(scene.triangles, parse_accel_config(spec));
     for (int round = 0; round < 3; ++round) {  // enough batches to learn and sample
         std::vector<Hit> hits(ref.rays.size());
         std::vector<std::uint8_t> occluded(ref.rays.size());
@@ -866,12 +904,19 @@ TEST(Routed, StreamedBatchesAnswerAsBruteForce) {
     }
     // Each path answered some of them: "closest packets P paired S stream T bvh-packets B; any ...".
     const std::string routes = routed->stats().setting("routed").value_or("");
-    for (const char* path : {" packets ", " paired ", " stream ", " bvh-packets "}) {
+    EXPECT_EQ(routes.find(" bvh-packets ") != std::string::npos, names.size() == 4) << routes;
+    for (const std::string& name : names) {
+        const std::string path = " " + name + " ";
         const std::size_t at = routes.find(path);
         ASSERT_NE(at, std::string::npos) << routes;
-        EXPECT_GT(std::stod(routes.substr(at + std::string(path).size())), 0.0) << path << "in: " << routes;
+        EXPECT_GT(std::stod(routes.substr(at + path.size())), 0.0) << path << "in: " << routes;
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Routed, RoutedPaths,
+                         ::testing::Values(std::pair{std::string("auto"), std::vector<std::string>{"packets", "paired", "stream", "bvh-packets"}},
+                                           std::pair{std::string("auto@packets=bvh"), std::vector<std::string>{"packets", "paired", "stream"}}),
+                         [](const auto& info) { return info.index == 0 ? std::string("KdPackets") : std::string("BvhPackets"); });
 
 }  // namespace
 }  // namespace cellrt

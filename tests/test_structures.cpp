@@ -29,7 +29,7 @@ namespace {
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
                                     "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih",
-                                    "auto@packets=bih-sah", "auto@route=coherence", "auto@streams=off", "bvh:paired",
+                                    "auto@packets=bih-sah", "auto@packets=bvh", "auto@route=coherence", "auto@streams=off", "bvh:paired",
                                     "bvh:stream", "bvh:packet"};
     for (detail::Isa isa : detail::available_isas())
         for (const char* kind : {"kd", "bih", "bvh", "bvh:paired", "bvh:stream", "bvh:packet"})

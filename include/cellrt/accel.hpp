@@ -36,6 +36,12 @@ std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Trian
 // Throws cellrt::Error for a malformed parameter; the parts themselves are checked by make_accelerator.
 AccelConfig parse_accel_config(std::string spec);
 
+// What a caller who names no configuration gets (the C API's NULL, Python's kind=None). On the CPU,
+// "auto@packets=bvh": one wide BVH (a build about twice Embree's), each batch routed to the traversal
+// that traces its kind fastest (docs/BVH.md). On the GPU ("cuda"), which traces the kd-tree and the
+// BIH only, "kd" (docs/GPU.md: the faster of the two there).
+AccelConfig default_accel_config(const std::string& device = "cpu");
+
 // Kinds built into this binary ("brute", "kd", "bih", and "embree" where Embree 3 was found).
 std::vector<std::string> accelerator_kinds();
 

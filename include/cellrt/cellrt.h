@@ -117,7 +117,8 @@ CELLRT_API cellrt_error cellrt_scene_get_info(cellrt_scene scene, size_t* triang
 
 /* Accelerators: a structure built over `scene` from a configuration string
  * KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd", "bih:branchless", "kd+auto@leaf_size=2", "brute";
- * NULL is "kd". Its kinds, traversals and parameters are those of `cellrt list`. */
+ * NULL is the library's default, "auto@packets=bvh" (one wide BVH, each batch on its fastest traversal;
+ * "kd" on "cuda" below). Its kinds, traversals and parameters are those of `cellrt list`. */
 CELLRT_API cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config);
 /* The same, traced where `where` says: "cpu" (or NULL), as cellrt_accel_new; "cuda": the tree built on
  * the host and traced on the GPU, one ray per GPU thread (kinds kd and bih, no SIMD set; docs/GPU.md).

@@ -134,6 +134,18 @@ std::unique_ptr<LocalStoreAccelerator> make_local_store_accelerator(std::span<co
     return e.local_store(triangles, config, local_store);
 }
 
+AccelConfig default_accel_config(const std::string& device) {
+    AccelConfig c;
+    if (device == "cuda") {
+        c.kind = "kd";
+    } else {
+        c.kind = "auto";
+        c.params = {{"packets", "bvh"}};
+    }
+    c.device = device;
+    return c;
+}
+
 AccelConfig parse_accel_config(std::string spec) {
     AccelConfig c;
     if (const auto at = spec.find('@'); at != std::string::npos) {

@@ -32,31 +32,37 @@ double thread_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// A path of the route: its name in the report, and what traces it.
+// A path of the route: its name in the report, what traces it, and whether that is a view of another
+// path's tree (bvh_with_traversal), whose build and memory the stats count once, with the tree's owner.
 struct RoutePath {
     const char* name;
     std::unique_ptr<Accelerator> accel;
+    bool view = false;
 };
 
 class RoutedAccelerator final : public Accelerator {
 public:
-    // paths[0] is the tree's packets and paths[1] the BVH's single rays, two at a time (coherence names
-    // one of them); the measured route may hold views of the BVH's tree traced otherwise
-    // (bvh_with_traversal) after them.
+    // paths[0] is the packets (the BVH's, or a study tree's) and paths[1] the BVH's single rays, two at
+    // a time (coherence names one of them); the measured route may hold views of the BVH's tree traced
+    // otherwise (bvh_with_traversal) after them.
     RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
         : paths_(std::move(paths)), threshold_(threshold), packets_(std::move(packets)), measured_(measured),
           pickers_{RoutePicker(count()), RoutePicker(count()), RoutePicker(count()), RoutePicker(count())} {}
 
     AccelStats stats() const override {
-        const AccelStats c = paths_[0].accel->stats(), i = paths_[1].accel->stats();
+        const AccelStats c = paths_[0].accel->stats();
         AccelStats s;
         s.name = "auto";
         s.traversal = "auto";
         s.simd_lanes = c.simd_lanes;
-        s.build_seconds = c.build_seconds + i.build_seconds;
-        s.build_cpu_seconds = c.build_cpu_seconds + i.build_cpu_seconds;
-        s.memory_bytes = c.memory_bytes + i.memory_bytes;  // the other paths trace the BVH's own tree
         s.triangles = c.triangles;
+        for (const RoutePath& p : paths_) {
+            if (p.view) continue;  // its tree is another path's
+            const AccelStats o = p.accel->stats();
+            s.build_seconds += o.build_seconds;
+            s.build_cpu_seconds += o.build_cpu_seconds;
+            s.memory_bytes += o.memory_bytes;
+        }
         s.settings = {{"packets", packets_},
                       {"coherence", param_number(threshold_)},
                       {"route", measured_ ? "measured" : "coherence"},
@@ -192,9 +198,10 @@ float batch_coherence(std::span<const Ray> rays) {
 const ParamTable& routed_params() {
     using enum ParamType;
     static const ParamTable table{
-        {"packets", choice, "kd", 0, 0, {"kd", "bih", "bih-sah"},
-         "the tree whose SIMD packets trace coherent batches: the kd-tree, the study's BIH, or the BIH "
-         "built by the SAH (bih@split=sah)"},
+        {"packets", choice, "kd", 0, 0, {"kd", "bih", "bih-sah", "bvh"},
+         "the tree whose SIMD packets trace coherent batches: the kd-tree, the study's BIH, the BIH built "
+         "by the SAH (bih@split=sah), or the wide BVH itself (bvh:packet: one tree, no second build, and "
+         "bvh_packets has no effect)"},
         {"coherence", number, "0.9", -1, 1, {},
          "a batch whose neighbouring rays' directions have at least this mean cosine goes to the packets, "
          "any other to the wide BVH (with route=measured: the first guess for its kind of batch)"},
@@ -226,28 +233,35 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     AccelConfig part;
     part.simd = config.simd == "off" ? "auto" : config.simd;  // the packets are the point of the route
     part.threads = config.threads;
-    // The packets' tree for each value of `packets` (checked against the table above): its kind and
-    // build parameters.
-    static const std::map<std::string, AccelConfig> kPacketTrees = {
-        {"kd", {.kind = "kd"}}, {"bih", {.kind = "bih"}}, {"bih-sah", {.kind = "bih", .params = {{"split", "sah"}}}}};
-    const AccelConfig& tree = kPacketTrees.at(packets);
-    part.kind = tree.kind;
-    part.params = tree.params;
-    std::unique_ptr<Accelerator> coherent = make_accelerator(triangles, part);
     // The BVH's single rays two at a time (bvh:paired): faster than one at a time on incoherent
     // batches, which are the ones this path is for (docs/INCOHERENT.md, "Eleventh round").
-    part.kind = "bvh";
-    part.traversal = "paired";
-    part.params.clear();
-    std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, part);
+    AccelConfig single = part;
+    single.kind = "bvh";
+    single.traversal = "paired";
     std::vector<RoutePath> paths;
-    paths.push_back({"packets", std::move(coherent)});
-    const Accelerator& tree_of_bvh = *bvh;
-    paths.push_back({"paired", std::move(bvh)});
+    if (packets == "bvh") {
+        // The BVH's own packets trace the coherent batches: one tree for every path.
+        std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, single);
+        const Accelerator& tree_of_bvh = *bvh;
+        paths.push_back({"packets", bvh_with_traversal(tree_of_bvh, "packet"), true});
+        paths.push_back({"paired", std::move(bvh)});
+    } else {
+        // The packets' tree for each other value of `packets` (checked against the table above): its
+        // kind and build parameters.
+        static const std::map<std::string, AccelConfig> kPacketTrees = {
+            {"kd", {.kind = "kd"}}, {"bih", {.kind = "bih"}}, {"bih-sah", {.kind = "bih", .params = {{"split", "sah"}}}}};
+        const AccelConfig& tree = kPacketTrees.at(packets);
+        part.kind = tree.kind;
+        part.params = tree.params;
+        paths.push_back({"packets", make_accelerator(triangles, part)});
+        paths.push_back({"paired", make_accelerator(triangles, single)});
+    }
+    const Accelerator& tree_of_bvh = *paths[1].accel;
     // Coherence alone names neither the streams nor the BVH's packets, so only the measured route
     // holds them: views of the BVH's tree, not further builds.
-    if (streams && measured) paths.push_back({"stream", bvh_with_traversal(tree_of_bvh, "stream")});
-    if (bvh_packets && measured) paths.push_back({"bvh-packets", bvh_with_traversal(tree_of_bvh, "packet")});
+    if (streams && measured) paths.push_back({"stream", bvh_with_traversal(tree_of_bvh, "stream"), true});
+    if (bvh_packets && measured && packets != "bvh")
+        paths.push_back({"bvh-packets", bvh_with_traversal(tree_of_bvh, "packet"), true});
     return std::make_unique<RoutedAccelerator>(std::move(paths), threshold, packets, measured);
 }
 

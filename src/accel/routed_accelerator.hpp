@@ -1,10 +1,12 @@
 // `--accel auto`: cellrt's fastest exact path for a mix of coherent and incoherent batches. It holds
-// two exact structures, SIMD packets over a study tree (fastest on coherent batches: a frame's primary
-// rays, shadow rays toward one light) and the wide BVH (fastest on incoherent ones: diffuse bounces,
-// AO, random queries), the latter traced as single rays two at a time (bvh:paired), as a stream (unless streams=off;
-// bvh_stream.inl: the batch's rays down the tree together) or in packets of eight rays (unless
-// bvh_packets=off; bvh_packet.inl), and routes each batch by its coherence
-// and by the time per ray each path has taken on batches of its kind (docs/BVH.md, docs/INCOHERENT.md).
+// two exact structures, SIMD packets over a study tree (packets=kd|bih|bih-sah: fastest on a frame's
+// square tiles of primary rays and shadow rays toward one light) and the wide BVH (fastest on
+// incoherent batches: diffuse bounces, AO, random queries), the latter traced as single rays two at a
+// time (bvh:paired), as a stream (unless streams=off; bvh_stream.inl: the batch's rays down the tree
+// together) or in packets of eight rays (unless bvh_packets=off; bvh_packet.inl). With packets=bvh
+// the BVH's own packets are the coherent batches' path: one tree, one build. It routes each batch by
+// its coherence and by the time per ray each path has taken on batches of its kind (docs/BVH.md,
+// docs/INCOHERENT.md).
 // Every path returns the brute-force hits, so the answers, and images, do not depend on the route.
 #pragma once
 
@@ -133,7 +135,8 @@ public:
     }
 
     struct Choice {
-        int path;    // 0: the packets, 1: the BVH's single rays, then its streams and packets, where held
+        int path;    // 0: the packets, 1: the BVH's single rays, then its streams and (a study tree's packets
+                     // being 0) its own packets, where held
         bool timed;  // a counted batch (not the warm-up) of a timed run: time it and record() it
     };
 

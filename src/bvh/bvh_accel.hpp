@@ -2,9 +2,9 @@
 // coherent packets (AO, diffuse bounces, random queries), one ray at a time with eight-wide SIMD over
 // a node's children and a leaf's triangles. Exact under the hit rule, like the trees.
 //
-// Build parameters: bvh_params(). The build runs on one thread (AccelConfig::threads is not used).
-// Traversals: "wide" (single rays, the default), "paired" (single rays, two walks at a time,
-// bvh_kernels.inl: faster on incoherent batches), "stream" (the batch's rays down the tree
+// Build parameters: bvh_params(). The build runs on AccelConfig::threads (its subtrees as oneTBB
+// tasks; the same tree at any count). Traversals: "paired" (single rays, two walks at a time,
+// bvh_kernels.inl; the default), "wide" (single rays, one walk), "stream" (the batch's rays down the tree
 // together, bvh_stream.inl: each node read once per stream) and "packet" (eight consecutive rays of
 // the batch together, one per lane, bvh_packet.inl). The kernels come from the registry, compiled for the instruction set
 // AccelConfig::simd names (registry: bvh_kernels_for; eight lanes in every set).

@@ -327,7 +327,8 @@ cellrt_accel new_accel(const char* name, cellrt_scene scene, const char* config,
         accel->device = d;
         accel->scene = s;
         try {
-            cellrt::AccelConfig c = config ? cellrt::parse_accel_config(config) : cellrt::AccelConfig{};
+            cellrt::AccelConfig c = config ? cellrt::parse_accel_config(config)
+                                           : cellrt::default_accel_config(where ? where : "cpu");
             if (where) c.device = where;
             accel->accelerator = cellrt::make_accelerator(s->triangles, c);
         } catch (const cellrt::Error& e) {

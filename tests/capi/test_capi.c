@@ -280,7 +280,7 @@ static int part_errors(void) {
     float nan_quad[12];
     cellrt_device device = cellrt_device_new(), other = cellrt_device_new();
     cellrt_scene scene, empty;
-    cellrt_accel accel, kd;
+    cellrt_accel accel, fallback;
     cellrt_ray ray = {0.75f, 0.25f, 1.f, 0.f, 0.f, 0.f, -1.f, INFINITY}; /* hits triangle 0 at t = 1 */
     cellrt_hit hit;
     uint8_t occ = 7;
@@ -352,8 +352,8 @@ static int part_errors(void) {
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "nosuch");
     CHECK(cellrt_accel_new(scene, "kd@leaf_size=-5") == NULL);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "leaf_size");
-    kd = cellrt_accel_new(scene, NULL); /* NULL: the default, the kd-tree */
-    CHECK(kd != NULL);
+    fallback = cellrt_accel_new(scene, NULL); /* NULL: the CPU's default, auto@packets=bvh */
+    CHECK(fallback != NULL);
     /* Where it runs: the CPU by name or by NULL; an unknown place refused; the GPU, or the reason
      * there is none (CI has none: the GPU's answers are tested by the C++ suite where it has one). */
     CHECK(cellrt_accel_new_on(scene, "kd", "tpu") == NULL);
@@ -377,68 +377,68 @@ static int part_errors(void) {
     CHECK(cellrt_accel_release(accel) == CELLRT_SUCCESS);
 
     /* Queries: handles, NULL arrays; a count of 0 needs no arrays; a bad ray misses. */
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == 0 && hit.t == 1.f);
-    CHECK(cellrt_occluded(kd, &ray, &occ, 1) == CELLRT_SUCCESS && occ == 1);
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == 0 && hit.t == 1.f);
+    CHECK(cellrt_occluded(fallback, &ray, &occ, 1) == CELLRT_SUCCESS && occ == 1);
     CHECK(cellrt_intersect(NULL, &ray, &hit, 1) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_intersect: accel is NULL");
     CHECK(cellrt_intersect((cellrt_accel)scene, &ray, &hit, 1) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "accel is not a live accel handle");
-    CHECK(cellrt_intersect(kd, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect(fallback, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "cellrt_intersect: rays is NULL, count 1");
-    CHECK(cellrt_intersect(kd, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect(fallback, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "hits is NULL");
-    CHECK(cellrt_intersect(kd, NULL, NULL, 0) == CELLRT_SUCCESS);
-    CHECK(cellrt_occluded(kd, NULL, &occ, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
+    CHECK(cellrt_occluded(fallback, NULL, &occ, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "cellrt_occluded: rays is NULL");
-    CHECK(cellrt_occluded(kd, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_occluded(fallback, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "occluded is NULL");
     CHECK(cellrt_occluded(NULL, &ray, &occ, 1) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_occluded: accel is NULL");
-    CHECK(cellrt_occluded(kd, NULL, NULL, 0) == CELLRT_SUCCESS);
+    CHECK(cellrt_occluded(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
     ray.org_x = NAN;
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == CELLRT_INVALID_ID);
-    CHECK(cellrt_occluded(kd, &ray, &occ, 1) == CELLRT_SUCCESS && occ == 0);
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == CELLRT_INVALID_ID);
+    CHECK(cellrt_occluded(fallback, &ray, &occ, 1) == CELLRT_SUCCESS && occ == 0);
     ray.org_x = 0.75f, ray.tfar = 0.5f; /* the quad at t = 1 lies beyond tfar */
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == CELLRT_INVALID_ID);
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == CELLRT_INVALID_ID);
     ray.tfar = INFINITY;
 
     memset(&soa, 0, sizeof soa);
     soa.org_x = &ray.org_x, soa.org_y = &ray.org_y, soa.org_z = &ray.org_z;
     soa.dir_x = &ray.dir_x, soa.dir_y = NULL, soa.dir_z = &ray.dir_z;
     soa_hits.t = &t, soa_hits.prim = &prim, soa_hits.u = NULL, soa_hits.v = NULL;
-    CHECK(cellrt_intersect_soa(kd, NULL, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, NULL, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "cellrt_intersect_soa: rays is NULL");
-    CHECK(cellrt_intersect_soa(kd, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "rays->dir_y is NULL");
-    CHECK(cellrt_occluded_soa(kd, &soa, &occ, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_occluded_soa(fallback, &soa, &occ, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "cellrt_occluded_soa: rays->dir_y is NULL");
     soa.dir_y = &ray.dir_y;
-    CHECK(cellrt_intersect_soa(kd, &soa, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, &soa, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "hits is NULL");
     soa_hits.t = NULL;
-    CHECK(cellrt_intersect_soa(kd, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "hits->t is NULL");
     soa_hits.t = &t, soa_hits.prim = NULL;
-    CHECK(cellrt_intersect_soa(kd, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, &soa, &soa_hits, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "hits->prim is NULL");
     soa_hits.prim = &prim;
-    CHECK(cellrt_intersect_soa(kd, &soa, &soa_hits, 1) == CELLRT_SUCCESS && prim == 0 && t == 1.f);
-    CHECK(cellrt_occluded_soa(kd, &soa, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect_soa(fallback, &soa, &soa_hits, 1) == CELLRT_SUCCESS && prim == 0 && t == 1.f);
+    CHECK(cellrt_occluded_soa(fallback, &soa, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "occluded is NULL");
     CHECK(cellrt_occluded_soa(NULL, &soa, &occ, 1) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "accel is NULL");
     occ = 7;
-    CHECK(cellrt_occluded_soa(kd, &soa, &occ, 1) == CELLRT_SUCCESS && occ == 1);
-    CHECK(cellrt_intersect_soa(kd, NULL, NULL, 0) == CELLRT_SUCCESS);
-    CHECK(cellrt_occluded_soa(kd, NULL, NULL, 0) == CELLRT_SUCCESS);
+    CHECK(cellrt_occluded_soa(fallback, &soa, &occ, 1) == CELLRT_SUCCESS && occ == 1);
+    CHECK(cellrt_intersect_soa(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
+    CHECK(cellrt_occluded_soa(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
 
     /* The error function: called with the code and the message on a failure, not once unset. */
     CHECK(cellrt_device_set_error_function(NULL, on_error, &calls) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_device_set_error_function: device is NULL");
     CHECK(cellrt_device_set_error_function(device, on_error, &calls) == CELLRT_SUCCESS);
-    CHECK(cellrt_intersect(kd, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK(cellrt_intersect(fallback, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK(calls.count == 1 && calls.code == CELLRT_ERROR_INVALID_ARGUMENT && strstr(calls.message, "rays is NULL"));
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_SUCCESS && calls.count == 1);
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_SUCCESS && calls.count == 1);
     CHECK(cellrt_device_get_error(other, NULL) == CELLRT_SUCCESS); /* errors stay on their device */
     CHECK(cellrt_device_set_error_function(device, NULL, NULL) == CELLRT_SUCCESS);
     CHECK(cellrt_accel_new(scene, "nosuch") == NULL && calls.count == 1);
@@ -457,7 +457,7 @@ static int part_errors(void) {
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_accel_retain: accel is NULL");
     CHECK(cellrt_accel_release((cellrt_accel)scene) == CELLRT_ERROR_INVALID_HANDLE); /* a scene is no accel */
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "accel is not a live accel handle");
-    CHECK(cellrt_accel_retain(kd) == CELLRT_SUCCESS);
+    CHECK(cellrt_accel_retain(fallback) == CELLRT_SUCCESS);
     CHECK(cellrt_scene_release(scene) == CELLRT_SUCCESS);   /* the accelerator keeps its scene */
     CHECK(cellrt_device_release(device) == CELLRT_SUCCESS); /* and the scene its device */
     CHECK(cellrt_scene_release(scene) == CELLRT_ERROR_INVALID_HANDLE);
@@ -466,14 +466,14 @@ static int part_errors(void) {
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_device_release: device is not a live device handle");
     CHECK(cellrt_scene_new(device, quad, 4, tris, 2) == NULL);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "device is not a live device handle");
-    CHECK(cellrt_accel_release(kd) == CELLRT_SUCCESS); /* one of two references */
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == 0);
-    CHECK(cellrt_intersect(kd, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT); /* to the released device */
+    CHECK(cellrt_accel_release(fallback) == CELLRT_SUCCESS); /* one of two references */
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_SUCCESS && hit.prim == 0);
+    CHECK(cellrt_intersect(fallback, NULL, &hit, 1) == CELLRT_ERROR_INVALID_ARGUMENT); /* to the released device */
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "rays is NULL");
-    CHECK(cellrt_accel_release(kd) == CELLRT_SUCCESS);
-    CHECK(cellrt_accel_release(kd) == CELLRT_ERROR_INVALID_HANDLE);
+    CHECK(cellrt_accel_release(fallback) == CELLRT_SUCCESS);
+    CHECK(cellrt_accel_release(fallback) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_accel_release: accel is not a live accel handle");
-    CHECK(cellrt_intersect(kd, &ray, &hit, 1) == CELLRT_ERROR_INVALID_HANDLE);
+    CHECK(cellrt_intersect(fallback, &ray, &hit, 1) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "accel is not a live accel handle");
     CHECK(cellrt_scene_release(empty) == CELLRT_SUCCESS);
     CHECK(cellrt_device_release(other) == CELLRT_SUCCESS);

@@ -176,6 +176,17 @@ def test_stats_are_typed(city):
     assert cellrt.Accelerator(city.triangles, kind="brute").stats.tree is None
 
 
+def test_the_default_kind_is_the_route_over_one_bvh_on_the_cpu(city):
+    # kind=None: `auto@packets=bvh`, which routes each batch to its fastest path over one wide BVH;
+    # params add to it.
+    acc = cellrt.Accelerator(city.triangles).stats
+    assert acc.name == "auto" and acc.settings["packets"] == "bvh"
+    streams_off = cellrt.Accelerator(city.triangles, kind=None, params={"streams": "off"}).stats.settings
+    assert streams_off["packets"] == "bvh" and streams_off["streams"] == "off"
+    assert cellrt.Accelerator(city.triangles, kind="auto").stats.settings["packets"] == "kd"
+    assert cellrt.Accelerator(city.triangles, kind="kd").stats.name == "kd"
+
+
 def test_empty_mesh_and_empty_batch():
     acc = cellrt.Accelerator(np.zeros((0, 3, 3), np.float32))
     r = acc.intersect(np.zeros((2, 3)), np.ones((2, 3)))

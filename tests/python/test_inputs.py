@@ -24,10 +24,10 @@ def test_library_errors_are_value_errors_with_the_library_message():
     assert issubclass(cellrt.Error, ValueError)
     with pytest.raises(cellrt.Error, match=r"unknown accelerator 'octree' \(choose one of: brute, kd"):
         cellrt.Accelerator(TRI, kind="octree")
-    with pytest.raises(cellrt.Error, match="unknown kd parameter"):
+    with pytest.raises(cellrt.Error, match="unknown auto parameter"):
         cellrt.Accelerator(TRI, params={"nonsense": 1})
     with pytest.raises(cellrt.Error, match="leaf_size"):
-        cellrt.Accelerator(TRI, params={"leaf_size": -4})
+        cellrt.Accelerator(TRI, kind="kd", params={"leaf_size": -4})
     with pytest.raises(cellrt.Error, match="traversal"):
         cellrt.Accelerator(TRI, kind="kd:zigzag", simd="off")
     with pytest.raises(cellrt.Error, match="neon"):
