@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""What a Python user gets from each kind: build time and rays per second, Embree beside them.
+
+    PYTHONPATH=build/python python3 bench/python_kinds.py [SCENE] [--kinds default,auto,kd,bvh,embree]
+                                                          [--threads 1] [--repeats 5] [--side 512] [--json F]
+
+Per kind (`default` is kind=None, the library's default), the build is timed --repeats times and one
+accelerator then traces, in rounds that take the kinds in turn: the camera's primary rays (SIDE x SIDE,
+row-major, as `scene.camera.rays` gives them) with `intersect`, and as many incoherent rays (random
+origins in the scene's box toward random triangles, as bench/python_bench.py makes them) with
+`intersect` and with `occluded`. Each accelerator traces every batch once before the rounds (its
+route, where it has one, learns there). Medians; the process's CPU time (all threads)."""
+import argparse
+import json
+import os
+import statistics
+import time
+
+import numpy as np
+
+import cellrt
+from python_bench import incoherent_rays
+
+
+def main():
+    default_scene = "../shared/scenes/sponza/sponza.json"
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="?", default=default_scene if os.path.exists(default_scene) else "builtin:city")
+    parser.add_argument("--kinds", default="default,auto,kd,bvh,embree,embree:packet16")
+    parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--side", type=int, default=512)
+    parser.add_argument("--json", help="write the medians as JSON")
+    args = parser.parse_args()
+    clock = time.process_time
+    scene = cellrt.load_scene(args.scene)
+    camera = scene.camera.rays(args.side, args.side)
+    incoherent = incoherent_rays(scene, args.side * args.side)
+    loads = {"camera": lambda a: a.intersect(*camera),
+             "incoherent closest": lambda a: a.intersect(*incoherent),
+             "incoherent any": lambda a: a.occluded(*incoherent)}
+    kinds = [k for k in args.kinds.split(",") if k.split(":")[0] in cellrt.kinds() or k == "default"]
+
+    def build(kind):
+        return cellrt.Accelerator(scene.triangles, kind=None if kind == "default" else kind, threads=args.threads)
+
+    builds = {k: [] for k in kinds}
+    for _ in range(args.repeats):
+        for k in kinds:
+            start = clock()
+            build(k)
+            builds[k].append(clock() - start)
+    accels = {k: build(k) for k in kinds}
+    for a in accels.values():
+        for load in loads.values():
+            load(a)
+    times = {(k, name): [] for k in kinds for name in loads}
+    for _ in range(args.repeats):
+        for k in kinds:
+            for name, load in loads.items():
+                start = clock()
+                load(accels[k])
+                times[(k, name)].append(clock() - start)
+    rays = args.side * args.side
+    result = []
+    for k in kinds:
+        row = {"kind": k, "config": accels[k].stats.name, "settings": dict(accels[k].stats.settings),
+               "build_seconds": statistics.median(builds[k])}
+        for name in loads:
+            row[name] = rays / statistics.median(times[(k, name)]) * 1e-6
+        result.append(row)
+    embree = [r for r in result if r["kind"].startswith("embree")]
+    print(f"{scene.name}: {len(scene.triangles)} triangles, {rays} rays a batch, threads {args.threads}, "
+          f"median of {args.repeats}, CPU time")
+    print("| kind | build ms | " + " | ".join(f"{n} Mrays/s" for n in loads) +
+          (" | " + " | ".join(f"{n} ÷ Embree's best" for n in loads) if embree else "") + " |")
+    print("|---|--:|" + "--:|" * (len(loads) * (2 if embree else 1)))
+    for r in result:
+        cells = [f"{1e3 * r['build_seconds']:.1f}"] + [f"{r[n]:.2f}" for n in loads]
+        if embree:
+            cells += [f"{r[n] / max(e[n] for e in embree):.2f}" for n in loads]
+        print(f"| {r['kind']} | " + " | ".join(cells) + " |")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
