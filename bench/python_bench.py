@@ -28,14 +28,20 @@ def incoherent_rays(scene, count, seed=1):
     return origins, (targets - origins).astype(np.float32)
 
 
-def main():
+def arguments(doc, kinds, repeats, threads, side):
+    """The options of the Python benchmarks (this one and python_kinds.py), with their defaults."""
     default_scene = "../shared/scenes/sponza/sponza.json"
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument("scene", nargs="?", default=default_scene if os.path.exists(default_scene) else "builtin:city")
-    parser.add_argument("--kinds", default="kd,bvh")
-    parser.add_argument("--repeats", type=int, default=9)
-    parser.add_argument("--threads", type=int, default=0)
-    parser.add_argument("--side", type=int, default=1024, help="batch of SIDE x SIDE rays")
+    parser.add_argument("--kinds", default=kinds)
+    parser.add_argument("--repeats", type=int, default=repeats)
+    parser.add_argument("--threads", type=int, default=threads)
+    parser.add_argument("--side", type=int, default=side, help="batch of SIDE x SIDE rays")
+    return parser
+
+
+def main():
+    parser = arguments(__doc__, "kd,bvh", 9, 0, 1024)
     parser.add_argument("--clock", choices=["wall", "cpu"], default="wall",
                         help="cpu: the process's CPU time, all threads (steadier on a shared machine)")
     args = parser.parse_args()

@@ -10,26 +10,16 @@ row-major, as `scene.camera.rays` gives them) with `intersect`, and as many inco
 origins in the scene's box toward random triangles, as bench/python_bench.py makes them) with
 `intersect` and with `occluded`. Each accelerator traces every batch once before the rounds (its
 route, where it has one, learns there). Medians; the process's CPU time (all threads)."""
-import argparse
 import json
-import os
 import statistics
 import time
 
-import numpy as np
-
 import cellrt
-from python_bench import incoherent_rays
+from python_bench import arguments, incoherent_rays
 
 
 def main():
-    default_scene = "../shared/scenes/sponza/sponza.json"
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scene", nargs="?", default=default_scene if os.path.exists(default_scene) else "builtin:city")
-    parser.add_argument("--kinds", default="default,auto,kd,bvh,embree,embree:packet16")
-    parser.add_argument("--threads", type=int, default=1)
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--side", type=int, default=512)
+    parser = arguments(__doc__, "default,auto,kd,bvh,embree,embree:packet16", 5, 1, 512)
     parser.add_argument("--json", help="write the medians as JSON")
     args = parser.parse_args()
     clock = time.process_time
