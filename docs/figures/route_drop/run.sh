@@ -19,3 +19,13 @@ for k in frame ao; do
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:packet16 auto auto@packets=bvh 2>/dev/null | grep "^|" > $D/ab_$k.md
 done
+# The second trial (docs/INCOHERENT.md, fifteenth round): 5fb8386 with every timed run after learning
+# first weighing the sums before it by 0.75 ($DECAY: that build's cellrt_bench), against 5fb8386, in
+# turn old new new old, 24 passes each (decay_*.json).
+n=0
+for who in old new new old; do
+  n=$((n + 1))
+  [ $who = old ] && B=$OLD/bench/cellrt_bench || B=${DECAY:?the decaying build}
+  $B --scenes-dir ../shared/scenes --scenes sponza sibenik bunny --size 256x256 --repeats 24 --builds 1 --clock cpu \
+    --rays frame --configs kd+auto bvh:packet auto --json $D/decay_${who}_$n.json > /dev/null 2>&1
+done
