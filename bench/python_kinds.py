@@ -9,7 +9,9 @@ accelerator then traces, in rounds that take the kinds in turn: the camera's pri
 row-major, as `scene.camera.rays` gives them) with `intersect`, and as many incoherent rays (random
 origins in the scene's box toward random triangles, as bench/python_bench.py makes them) with
 `intersect` and with `occluded`. Each accelerator traces every batch once before the rounds (its
-route, where it has one, learns there). Medians; the process's CPU time (all threads)."""
+route, where it has one, learns there). With --render, each round also renders the scene at SIDE x SIDE
+with `cellrt.render(scene, kind=...)`, its build included, as a caller of render meets it. Medians; the
+process's CPU time (all threads)."""
 import json
 import statistics
 import time
@@ -21,6 +23,7 @@ from python_bench import arguments, incoherent_rays
 def main():
     parser = arguments(__doc__, "default,auto,kd,bvh,embree,embree:packet16", 5, 1, 512)
     parser.add_argument("--json", help="write the medians as JSON")
+    parser.add_argument("--render", action="store_true", help="also time a whole render, build included")
     args = parser.parse_args()
     clock = time.process_time
     scene = cellrt.load_scene(args.scene)
@@ -45,12 +48,18 @@ def main():
         for load in loads.values():
             load(a)
     times = {(k, name): [] for k in kinds for name in loads}
+    renders = {k: [] for k in kinds}
     for _ in range(args.repeats):
         for k in kinds:
             for name, load in loads.items():
                 start = clock()
                 load(accels[k])
                 times[(k, name)].append(clock() - start)
+            if args.render:
+                start = clock()
+                cellrt.render(scene, kind=None if k == "default" else k, size=(args.side, args.side),
+                              threads=args.threads)
+                renders[k].append(clock() - start)
     rays = args.side * args.side
     result = []
     for k in kinds:
@@ -58,17 +67,22 @@ def main():
                "build_seconds": statistics.median(builds[k])}
         for name in loads:
             row[name] = rays / statistics.median(times[(k, name)]) * 1e-6
+        if args.render:
+            row["render_seconds"] = statistics.median(renders[k])
         result.append(row)
     embree = [r for r in result if r["kind"].startswith("embree")]
     print(f"{scene.name}: {len(scene.triangles)} triangles, {rays} rays a batch, threads {args.threads}, "
           f"median of {args.repeats}, CPU time")
     print("| kind | build ms | " + " | ".join(f"{n} Mrays/s" for n in loads) +
-          (" | " + " | ".join(f"{n} ÷ Embree's best" for n in loads) if embree else "") + " |")
-    print("|---|--:|" + "--:|" * (len(loads) * (2 if embree else 1)))
+          (" | " + " | ".join(f"{n} ÷ Embree's best" for n in loads) if embree else "") +
+          (" | render s |" if args.render else " |"))
+    print("|---|--:|" + "--:|" * (len(loads) * (2 if embree else 1) + (1 if args.render else 0)))
     for r in result:
         cells = [f"{1e3 * r['build_seconds']:.1f}"] + [f"{r[n]:.2f}" for n in loads]
         if embree:
             cells += [f"{r[n] / max(e[n] for e in embree):.2f}" for n in loads]
+        if args.render:
+            cells.append(f"{r['render_seconds']:.3f}")
         print(f"| {r['kind']} | " + " | ".join(cells) + " |")
     if args.json:
         with open(args.json, "w") as f:

@@ -321,11 +321,12 @@ PYBIND11_MODULE(cellrt, m) {
     m.def("load_scene", &load, py::arg("path"),
           "A view file (.json), a mesh (.obj, .ply, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "
           "cellrt.Error with the library's message naming the file and line.");
-    m.def("render", &render_scene, py::arg("scene"), py::kw_only(), py::arg("kind") = "kd",
+    m.def("render", &render_scene, py::arg("scene"), py::kw_only(), py::arg("kind") = py::none(),
           py::arg("size") = py::none(), py::arg("shading") = "direct", py::arg("threads") = 0, py::arg("ao_samples") = 4,
           py::arg("device") = "cpu",
           "The scene rendered as cellrt render renders it: an (H, W, 3) float32 array, the values of its PFM, row 0 "
-          "at the top. device='cuda': every pixel made on the GPU, the same array bit for bit.");
+          "at the top, the same bits with every kind (None: the library's default, as for Accelerator). "
+          "device='cuda': every pixel made on the GPU, the same array bit for bit.");
     m.def(
         "device_info",
         [] {

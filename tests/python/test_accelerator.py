@@ -187,6 +187,14 @@ def test_the_default_kind_is_the_route_over_one_bvh_on_the_cpu(city):
     assert cellrt.Accelerator(city.triangles, kind="kd").stats.name == "kd"
 
 
+def test_the_default_render_is_the_kd_trees_image_bit_for_bit(city):
+    # kind=None renders over the library's default (one wide BVH), the CLI's default over the kd-tree.
+    for shading in ("direct", "diffuse"):
+        default = cellrt.render(city, size=(41, 29), shading=shading)
+        kd = cellrt.render(city, kind="kd", size=(41, 29), shading=shading)
+        assert np.array_equal(default.view(np.uint32), kd.view(np.uint32))
+
+
 def test_empty_mesh_and_empty_batch():
     acc = cellrt.Accelerator(np.zeros((0, 3, 3), np.float32))
     r = acc.intersect(np.zeros((2, 3)), np.ones((2, 3)))
