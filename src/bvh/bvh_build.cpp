@@ -199,9 +199,13 @@ private:
             acc = LaneBox::empty();
             n = 0;
             for (int k = 1; k < bins; ++k) {
+                // After an empty bin the candidate is the one before it, box for box (extending by an
+                // empty box changes no bit), so its cost is no less: a small node's many empty bins
+                // are passed over without their areas.
+                if (binned.count[a][k - 1] == 0) continue;
                 acc.extend(binned.box[a][k - 1]);
                 n += binned.count[a][k - 1];
-                if (n == 0 || right_count[k] == 0) continue;
+                if (right_count[k] == 0) continue;
                 const double c = split_cost(acc.area(), n, right_box[k].area(), right_count[k], parent);
                 if (best.axis < 0 || c < best.cost) best = {a, k, c, false, 0.f, acc.box(), right_box[k].box()};
             }
