@@ -238,29 +238,29 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     AccelConfig single = part;
     single.kind = "bvh";
     single.traversal = "paired";
-    std::vector<RoutePath> paths;
-    if (packets == "bvh") {
-        // The BVH's own packets trace the coherent batches: one tree for every path.
-        std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, single);
-        const Accelerator& tree_of_bvh = *bvh;
-        paths.push_back({"packets", bvh_with_traversal(tree_of_bvh, "packet"), true});
-        paths.push_back({"paired", std::move(bvh)});
-    } else {
-        // The packets' tree for each other value of `packets` (checked against the table above): its
-        // kind and build parameters.
-        static const std::map<std::string, AccelConfig> kPacketTrees = {
-            {"kd", {.kind = "kd"}}, {"bih", {.kind = "bih"}}, {"bih-sah", {.kind = "bih", .params = {{"split", "sah"}}}}};
-        const AccelConfig& tree = kPacketTrees.at(packets);
-        part.kind = tree.kind;
-        part.params = tree.params;
-        paths.push_back({"packets", make_accelerator(triangles, part)});
-        paths.push_back({"paired", make_accelerator(triangles, single)});
+    // The packets' tree for each other value of `packets` (checked against the table above): its kind
+    // and build parameters; with packets=bvh the BVH's own packets (a view of its tree) instead.
+    static const std::map<std::string, AccelConfig> kPacketTrees = {
+        {"kd", {.kind = "kd"}}, {"bih", {.kind = "bih"}}, {"bih-sah", {.kind = "bih", .params = {{"split", "sah"}}}}};
+    std::unique_ptr<Accelerator> coherent;
+    if (const auto tree = kPacketTrees.find(packets); tree != kPacketTrees.end()) {
+        part.kind = tree->second.kind;
+        part.params = tree->second.params;
+        coherent = make_accelerator(triangles, part);
     }
-    const Accelerator& tree_of_bvh = *paths[1].accel;
+    std::unique_ptr<Accelerator> bvh = make_accelerator(triangles, single);
+    const Accelerator& tree_of_bvh = *bvh;
+    std::vector<RoutePath> paths;
+    if (coherent)
+        paths.push_back({"packets", std::move(coherent)});
+    else
+        paths.push_back({"packets", bvh_with_traversal(tree_of_bvh, "packet"), true});
+    paths.push_back({"paired", std::move(bvh)});
     // Coherence alone names neither the streams nor the BVH's packets, so only the measured route
-    // holds them: views of the BVH's tree, not further builds.
+    // holds them: views of the BVH's tree, not further builds (its packets are the first path already
+    // where they trace the coherent batches).
     if (streams && measured) paths.push_back({"stream", bvh_with_traversal(tree_of_bvh, "stream"), true});
-    if (bvh_packets && measured && packets != "bvh")
+    if (bvh_packets && measured && !paths[0].view)
         paths.push_back({"bvh-packets", bvh_with_traversal(tree_of_bvh, "packet"), true});
     return std::make_unique<RoutedAccelerator>(std::move(paths), threshold, packets, measured);
 }
