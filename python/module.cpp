@@ -27,6 +27,7 @@ struct PyAccelerator {
     std::vector<Triangle> triangles;
     std::unique_ptr<Accelerator> accel;
     Team team;
+    AccelConfig config;  // as built
 };
 
 std::string param_value(py::handle value, const std::string& name) {
@@ -66,7 +67,7 @@ AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, p
 }
 
 std::unique_ptr<PyAccelerator> build(std::vector<Triangle> triangles, const AccelConfig& config) {
-    auto a = std::make_unique<PyAccelerator>(PyAccelerator{std::move(triangles), nullptr, Team(config.threads)});
+    auto a = std::make_unique<PyAccelerator>(PyAccelerator{std::move(triangles), nullptr, Team(config.threads), config});
     py::gil_scoped_release unlocked;
     a->accel = make_accelerator(a->triangles, config);
     return a;
@@ -270,7 +271,11 @@ PYBIND11_MODULE(cellrt, m) {
              py::arg("tfar") = std::numeric_limits<double>::infinity(),
              "Any hit with tnear <= t <= tfar: a bool array.")
         .def_property_readonly("stats", [](const PyAccelerator& a) { return a.accel->stats(); },
-                               "AccelStats: build time, memory, the structure's report");
+                               "AccelStats: build time, memory, the structure's report")
+        .def_property_readonly("config", [](const PyAccelerator& a) { return format_accel_config(a.config); },
+                               "the configuration built, as one string (e.g. 'auto+auto@packets=bvh')")
+        .def_property_readonly("device", [](const PyAccelerator& a) { return a.config.device; },
+                               "where it traces: 'cpu' or 'cuda'");
 
     py::class_<Camera> camera(m, "Camera", "A pinhole camera: position, look_at, up, fov_y_deg (full vertical, degrees)");
     camera.def(py::init<>());

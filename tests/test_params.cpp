@@ -188,5 +188,29 @@ TEST(Params, AcceleratorSpecsSplitOrAreRefused) {
     EXPECT_THROW(make_accelerator(small_scene(), parse_accel_config("kd+avx2:rec")), Error);  // SIMD set 'avx2:rec'
 }
 
+// A configuration written back is the canonical spec that parses to it: parts left out when absent
+// or "off", parameters by name, the last of a repeated name kept (as the parse keeps it).
+TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
+    for (const auto& [spec, canonical] : std::vector<std::pair<std::string, std::string>>{
+             {"kd", "kd"},
+             {"kd:rec", "kd:rec"},
+             {"kd+off", "kd"},
+             {"bih+avx2", "bih+avx2"},
+             {"kd:rec+avx2@leaf_size=2,bins=64", "kd:rec+avx2@bins=64,leaf_size=2"},
+             {"auto@packets=bvh", "auto@packets=bvh"},
+             {"bvh@bins=8,bins=16", "bvh@bins=16"},
+             {"kd@note=a:b+c", "kd@note=a:b+c"}}) {
+        const AccelConfig c = parse_accel_config(spec);
+        EXPECT_EQ(format_accel_config(c), canonical) << spec;
+        const AccelConfig back = parse_accel_config(format_accel_config(c));
+        EXPECT_EQ(back.kind, c.kind) << spec;
+        EXPECT_EQ(back.traversal, c.traversal) << spec;
+        EXPECT_EQ(back.simd, c.simd) << spec;
+        EXPECT_EQ(back.params, c.params) << spec;
+    }
+    EXPECT_EQ(format_accel_config(default_accel_config()), "auto@packets=bvh");
+    EXPECT_EQ(format_accel_config(default_accel_config("cuda")), "kd");
+}
+
 }  // namespace
 }  // namespace cellrt

@@ -36,6 +36,12 @@ std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Trian
 // Throws cellrt::Error for a malformed parameter; the parts themselves are checked by make_accelerator.
 AccelConfig parse_accel_config(std::string spec);
 
+// The configuration written as parse_accel_config reads it, in one canonical form: the traversal when
+// named, the SIMD set unless "off", the parameters sorted by name (e.g. "auto@packets=bvh"). The
+// threads and the device are not part of the string. parse_accel_config of the result gives back
+// `config`'s kind, traversal, SIMD set and parameters.
+std::string format_accel_config(const AccelConfig& config);
+
 // What a caller who names no configuration gets (the C API's NULL, Python's kind=None). On the CPU,
 // "auto@packets=bvh": one wide BVH (a build about twice Embree's), each batch routed to the traversal
 // that traces its kind fastest (docs/BVH.md). On the GPU ("cuda"), which traces the kd-tree and the

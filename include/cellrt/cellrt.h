@@ -38,7 +38,7 @@ extern "C" {
 #endif
 
 /* The version of this API; changes when a declaration below changes. */
-#define CELLRT_C_API_VERSION 2
+#define CELLRT_C_API_VERSION 3
 
 /* prim of a ray that hits nothing. */
 #define CELLRT_INVALID_ID UINT32_MAX
@@ -127,6 +127,12 @@ CELLRT_API cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config)
 CELLRT_API cellrt_accel cellrt_accel_new_on(cellrt_scene scene, const char* config, const char* where);
 CELLRT_API cellrt_error cellrt_accel_retain(cellrt_accel accel);
 CELLRT_API cellrt_error cellrt_accel_release(cellrt_accel accel);
+/* What `accel` is: the configuration it was built from, in full ("auto@packets=bvh" for NULL on the
+ * CPU; parameters sorted by name), where it traces ("cpu" or "cuda"), both valid while the
+ * accelerator lives; the build's wall time in seconds and the bytes its structure holds. Each output
+ * may be NULL. Since version 3. */
+CELLRT_API cellrt_error cellrt_accel_get_info(cellrt_accel accel, const char** config, const char** where,
+                                              double* build_seconds, size_t* memory_bytes);
 
 /* Closest hits of `count` rays; arrays may be NULL when count is 0. */
 CELLRT_API cellrt_error cellrt_intersect(cellrt_accel accel, const cellrt_ray* rays, cellrt_hit* hits, size_t count);

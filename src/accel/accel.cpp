@@ -171,4 +171,16 @@ AccelConfig parse_accel_config(std::string spec) {
     return c;
 }
 
+std::string format_accel_config(const AccelConfig& config) {
+    std::string s = config.kind;
+    if (!config.traversal.empty()) s += ":" + config.traversal;
+    if (config.simd != "off") s += "+" + config.simd;
+    char separator = '@';
+    for (const auto& [name, value] : config.params) {
+        s += separator + name + "=" + value;
+        separator = ',';
+    }
+    return s;
+}
+
 }  // namespace cellrt

@@ -331,6 +331,11 @@ cellrt_accel new_accel(const char* name, cellrt_scene scene, const char* config,
                                            : cellrt::default_accel_config(where ? where : "cpu");
             if (where) c.device = where;
             accel->accelerator = cellrt::make_accelerator(s->triangles, c);
+            accel->config = cellrt::format_accel_config(c);
+            accel->where = c.device;
+            const cellrt::AccelStats stats = accel->accelerator->stats();
+            accel->build_seconds = stats.build_seconds;
+            accel->memory_bytes = stats.memory_bytes;
         } catch (const cellrt::Error& e) {
             fail(CELLRT_ERROR_INVALID_CONFIG, "config '" + std::string(config ? config : "") + "'" +
                                                   (where ? " on '" + std::string(where) + "'" : "") + ": " + e.what());
@@ -356,6 +361,19 @@ cellrt_error cellrt_accel_retain(cellrt_accel accel) {
 
 cellrt_error cellrt_accel_release(cellrt_accel accel) {
     return count<Accel>("cellrt_accel_release", id_of(accel), "accel", -1);
+}
+
+cellrt_error cellrt_accel_get_info(cellrt_accel accel, const char** config, const char** where, double* build_seconds,
+                                   size_t* memory_bytes) {
+    std::shared_ptr<Device> d;
+    return guarded("cellrt_accel_get_info", d, [&] {
+        const auto a = find<Accel>(id_of(accel), "accel");
+        d = a->device;
+        if (config) *config = a->config.c_str();
+        if (where) *where = a->where.c_str();
+        if (build_seconds) *build_seconds = a->build_seconds;
+        if (memory_bytes) *memory_bytes = a->memory_bytes;
+    });
 }
 
 cellrt_error cellrt_intersect(cellrt_accel accel, const cellrt_ray* rays, cellrt_hit* hits, size_t count) {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
+#include <string>
 #include <unordered_map>
 #include <variant>
 #include <vector>
@@ -34,6 +35,10 @@ struct Accel {
     std::shared_ptr<Device> device;
     std::shared_ptr<const SceneData> scene;  // kept as long as the structure that may read it
     std::unique_ptr<Accelerator> accelerator;
+    // What cellrt_accel_get_info reports, fixed at the build (so that reading it takes no lock).
+    std::string config, where;
+    double build_seconds = 0.0;
+    std::size_t memory_bytes = 0;
 };
 
 using Object = std::variant<std::shared_ptr<Device>, std::shared_ptr<SceneData>, std::shared_ptr<Accel>>;

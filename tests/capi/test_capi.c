@@ -354,6 +354,26 @@ static int part_errors(void) {
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "leaf_size");
     fallback = cellrt_accel_new(scene, NULL); /* NULL: the CPU's default, auto@packets=bvh */
     CHECK(fallback != NULL);
+    /* What an accelerator is: NULL's configuration named in full, a given one in canonical form. */
+    {
+        const char *config = NULL, *where = NULL;
+        double seconds = -1.0;
+        size_t bytes = 0;
+        CHECK(cellrt_accel_get_info(fallback, &config, &where, &seconds, &bytes) == CELLRT_SUCCESS);
+        CHECK(config != NULL && strcmp(config, "auto@packets=bvh") == 0);
+        CHECK(where != NULL && strcmp(where, "cpu") == 0);
+        CHECK(seconds >= 0.0 && bytes > 0);
+        CHECK(cellrt_accel_get_info(fallback, NULL, NULL, NULL, NULL) == CELLRT_SUCCESS);
+        accel = cellrt_accel_new_on(scene, "kd:rec@leaf_size=2,bins=64", "cpu");
+        CHECK(accel != NULL);
+        CHECK(cellrt_accel_get_info(accel, &config, &where, NULL, NULL) == CELLRT_SUCCESS);
+        CHECK(strcmp(config, "kd:rec@bins=64,leaf_size=2") == 0 && strcmp(where, "cpu") == 0);
+        CHECK(cellrt_accel_release(accel) == CELLRT_SUCCESS);
+        CHECK(cellrt_accel_get_info(accel, &config, NULL, NULL, NULL) == CELLRT_ERROR_INVALID_HANDLE);
+        CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_accel_get_info: accel is not a live accel handle");
+        CHECK(cellrt_accel_get_info((cellrt_accel)scene, NULL, NULL, NULL, NULL) == CELLRT_ERROR_INVALID_HANDLE);
+        CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "accel is not a live accel handle");
+    }
     /* Where it runs: the CPU by name or by NULL; an unknown place refused; the GPU, or the reason
      * there is none (CI has none: the GPU's answers are tested by the C++ suite where it has one). */
     CHECK(cellrt_accel_new_on(scene, "kd", "tpu") == NULL);
@@ -366,6 +386,9 @@ static int part_errors(void) {
     }
     accel = cellrt_accel_new_on(scene, "bih", "cuda");
     if (accel) {
+        const char *config = NULL, *where = NULL;
+        CHECK(cellrt_accel_get_info(accel, &config, &where, NULL, NULL) == CELLRT_SUCCESS);
+        CHECK(strcmp(config, "bih") == 0 && strcmp(where, "cuda") == 0);
         CHECK(cellrt_intersect(accel, &ray, &hit, 1) == CELLRT_SUCCESS);
         CHECK(cellrt_accel_release(accel) == CELLRT_SUCCESS);
     } else {

@@ -187,6 +187,14 @@ def test_the_default_kind_is_the_route_over_one_bvh_on_the_cpu(city):
     assert cellrt.Accelerator(city.triangles, kind="kd").stats.name == "kd"
 
 
+def test_an_accelerator_names_its_configuration(city):
+    # The configuration built, as one string that cellrt_bench and the CLI read back.
+    default = cellrt.Accelerator(city.triangles)
+    assert default.config == "auto+auto@packets=bvh" and default.device == "cpu"
+    kd = cellrt.Accelerator(city.triangles, kind="kd:rec", simd="off", params={"leaf_size": 2, "bins": 64})
+    assert kd.config == "kd:rec@bins=64,leaf_size=2"
+
+
 def test_the_default_render_is_the_kd_trees_image_bit_for_bit(city):
     # kind=None renders over the library's default (one wide BVH), the CLI's default over the kd-tree.
     for shading in ("direct", "diffuse"):
