@@ -55,7 +55,8 @@ TEST(Bvh, BuildVariantsMatchBruteForce) {
 // spatial splits each triangle lies in exactly one leaf and every child box is exactly the bounds of
 // the triangles below it. With them a triangle may lie in several leaves, cut by the planes between
 // them: then a leaf's box lies within its triangles' bounds, an inner child's box holds its
-// children's, and each vertex of a triangle lies in the box of one of the leaves that hold it.
+// children's, and each vertex of a triangle lies in the box of one of the leaves that hold it. A
+// node's children come by decreasing box area (any-hit traversals take the first one met).
 void check_tree(const BvhTree& tree, std::span<const Triangle> tris, int max_leaf, bool spatial = false) {
     std::vector<int> seen(tris.size(), 0);
     std::vector<std::vector<Box3>> leaf_boxes(tris.size());
@@ -85,6 +86,7 @@ void check_tree(const BvhTree& tree, std::span<const Triangle> tris, int max_lea
         }
         const BvhNode& node = tree.nodes[word];
         Box3 children;
+        float previous_area = kInfinity;
         for (int k = 0; k < detail::kBvhWidth; ++k) {
             if (node.child[k] == BvhNode::kEmptyChild) {
                 EXPECT_GT(node.lo[0][k], node.hi[0][k]) << "an empty slot's box is empty";
@@ -92,6 +94,8 @@ void check_tree(const BvhTree& tree, std::span<const Triangle> tris, int max_lea
             }
             Box3 box;
             for (int a = 0; a < 3; ++a) box.lo[a] = node.lo[a][k], box.hi[a] = node.hi[a][k];
+            EXPECT_LE(box.area(), previous_area) << "children not by decreasing box area";
+            previous_area = box.area();
             const Box3 child = walk(node.child[k], box);
             if (spatial) {
                 EXPECT_EQ(intersection(box, child), box) << "a box beyond its triangles' bounds";
