@@ -1,0 +1,23 @@
+#!/bin/sh
+# Sixteenth round (docs/INCOHERENT.md): the BVH's children by decreasing box area. Old and new
+# cellrt_bench copied to /tmp/ab first (bench_base: main before the change, 5224d04; bench_v1: the
+# change; bench_v2: the same slot order with the nodes laid out in the collapse's order, not kept).
+# Run from the repository root.
+D=docs/figures/any_hit_order
+for rays in random ao frame diffuse; do
+  bench/ab_compare.py /tmp/ab/bench_base /tmp/ab/bench_v1 --rounds 2 --json $D/ab_$rays.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:single embree:packet8 bvh:paired bvh:packet bvh:stream auto \
+    --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $rays | grep '^|' > $D/ab_$rays.md
+done
+for rays in random frame; do
+  bench/ab_compare.py /tmp/ab/bench_base /tmp/ab/bench_v2 --rounds 2 --json $D/ab2_$rays.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:single embree:packet8 bvh:paired bvh:packet bvh:stream auto \
+    --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $rays | grep '^|' > $D/ab2_$rays.md
+done
+bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_v2 --rounds 3 --json $D/ab_v1v2_frame.json -- \
+  --scenes-dir ../shared/scenes --scenes sponza sibenik bunny --configs embree:single bvh:paired bvh:packet \
+  --size 256x256 --repeats 5 --builds 1 --clock cpu --rays frame
+bench/incoherent_state.sh $D    # the state table: summary.md
+python3 /split.py $D docs/figures/incoherent_round13   # closest and any hits apart
