@@ -21,3 +21,14 @@ bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_v2 --rounds 3 --json $D/ab_v1
   --size 256x256 --repeats 5 --builds 1 --clock cpu --rays frame
 bench/incoherent_state.sh $D    # the state table: summary.md
 python3 /split.py $D docs/figures/incoherent_round13   # closest and any hits apart
+# The forest, and the nearest child's ties to the smallest box (bench_v3: nearest_lane's key with the
+# lane order reversed; not kept):
+for rays in random frame; do
+  bench/ab_compare.py /tmp/ab/bench_base /tmp/ab/bench_v1 --rounds 2 --json $D/ab_forest_$rays.json -- \
+    --scenes-dir ../shared/scenes --scenes 'builtin:forest?tris=200000' \
+    --configs embree:single embree:packet8 bvh:paired bvh:packet bvh:stream auto \
+    --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $rays
+done
+bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_v3 --rounds 2 --json $D/ab_v1v3_frame.json -- \
+  --scenes-dir ../shared/scenes --scenes sponza sibenik bunny 'builtin:forest?tris=200000' \
+  --configs embree:single bvh:paired bvh:wide --size 256x256 --repeats 5 --builds 1 --clock cpu --rays frame
