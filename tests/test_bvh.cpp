@@ -849,7 +849,14 @@ TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
     EXPECT_EQ(setting("auto@bvh_packets=off", "streams"), "on");
     // With the BVH's own packets for coherent batches, they are the first path, not a fourth.
     EXPECT_EQ(setting("auto", "packets"), "kd");
-    EXPECT_EQ(setting("auto@packets=bvh", "bvh_packets"), "off");
+    EXPECT_EQ(setting("auto@packets=bvh", "bvh_packets"), "on");
+    EXPECT_EQ(setting("auto@packets=bvh,bvh_packets=on", "bvh_packets"), "on");
+    try {
+        make_accelerator(scene.triangles, parse_accel_config("auto@packets=bvh,bvh_packets=off"));
+        ADD_FAILURE() << "bvh_packets=off accepted with packets=bvh";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("bvh_packets=off contradicts packets=bvh"), std::string::npos) << e.what();
+    }
     EXPECT_EQ(setting("auto@packets=bvh", "streams"), "on");
 }
 

@@ -12,6 +12,7 @@
 
 #include "bvh/bvh_accel.hpp"
 #include "cellrt/accel.hpp"
+#include "cellrt/error.hpp"
 #include "kernel/param_reader.hpp"
 
 namespace cellrt::detail {
@@ -67,7 +68,7 @@ public:
                       {"coherence", param_number(threshold_)},
                       {"route", measured_ ? "measured" : "coherence"},
                       {"streams", holds("stream") ? "on" : "off"},
-                      {"bvh_packets", holds("bvh-packets") ? "on" : "off"},
+                      {"bvh_packets", holds("bvh-packets") || packets_ == "bvh" ? "on" : "off"},
                       {"routed", routed()}};
         return s;
     }
@@ -201,7 +202,7 @@ const ParamTable& routed_params() {
         {"packets", choice, "kd", 0, 0, {"kd", "bih", "bih-sah", "bvh"},
          "the tree whose SIMD packets trace coherent batches: the kd-tree, the study's BIH, the BIH built "
          "by the SAH (bih@split=sah), or the wide BVH itself (bvh:packet: one tree, no second build, and "
-         "bvh_packets has no effect)"},
+         "bvh_packets is on, and off is refused)"},
         {"coherence", number, "0.9", -1, 1, {},
          "a batch whose neighbouring rays' directions have at least this mean cosine goes to the packets, "
          "any other to the wide BVH (with route=measured: the first guess for its kind of batch)"},
@@ -229,6 +230,10 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     const bool streams = params.choice("streams") == "on";
     const bool bvh_packets = params.choice("bvh_packets") == "on";
     params.finish();
+    // With packets=bvh the BVH's packets are the coherent batches' path: they cannot be left out.
+    if (packets == "bvh" && !bvh_packets)
+        throw Error("auto: bvh_packets=off contradicts packets=bvh, whose packets are the BVH's own (leave "
+                    "bvh_packets out, or choose another tree for the packets)");
     choose_traversal(kTraversals, config.traversal, "auto");
     AccelConfig part;
     part.simd = config.simd == "off" ? "auto" : config.simd;  // the packets are the point of the route
