@@ -25,7 +25,11 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
     std::string kinds;
     for (const auto& k : accelerator_kinds()) kinds += (kinds.empty() ? "" : "|") + k;
     if (kind_optional) kind.clear();
-    cmd.add_option("--accel", kind, "Acceleration structure: " + kinds)->capture_default_str();
+    cmd.add_option("--accel", kind,
+                   "Acceleration structure: " + kinds +
+                       ", or a whole configuration KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...] as the benchmarks, the C "
+                       "API and Python name it (the options below add to it)")
+        ->capture_default_str();
     cmd.add_option("--traversal", traversal,
                    "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|paired|stream|packet); "
                    "implies --simd off");
@@ -42,17 +46,37 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
 
 AccelConfig AccelOptions::config() const {
     check_threads(threads);
+    // --accel is a kind or the library's whole configuration string (parse_accel_config); --traversal,
+    // --simd and -P add to it and may not contradict it.
     AccelConfig c;
-    c.kind = kind;
-    c.traversal = traversal;
+    try {
+        c = parse_accel_config(kind);
+    } catch (const Error& e) {
+        throw Error("--accel '" + kind + "': " + e.what());
+    }
+    const auto contradiction = [&](const std::string& option) {
+        return Error(option + " contradicts --accel '" + kind + "'");
+    };
+    if (!traversal.empty()) {
+        if (!c.traversal.empty() && c.traversal != traversal) throw contradiction("--traversal '" + traversal + "'");
+        c.traversal = traversal;
+    }
     const bool simd_given = simd_option && simd_option->count() > 0;
-    c.simd = (!traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
+    const bool simd_named = kind.substr(0, kind.find('@')).find('+') != std::string::npos;
+    if (simd_named) {
+        if (simd_given && simd != c.simd) throw contradiction("--simd '" + simd + "'");
+    } else {
+        c.simd = (!c.traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
+    }
     c.device = device;
     c.threads = threads;
     for (const std::string& p : params) {
         const auto eq = p.find('=');
         if (eq == std::string::npos || eq == 0) throw Error("--param '" + p + "' must have the form NAME=VALUE");
-        c.params[p.substr(0, eq)] = p.substr(eq + 1);
+        const std::string name = p.substr(0, eq), value = p.substr(eq + 1);
+        if (const auto it = c.params.find(name); it != c.params.end() && it->second != value)
+            throw contradiction("--param '" + p + "'");
+        c.params[name] = value;
     }
     return c;
 }

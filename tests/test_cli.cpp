@@ -107,6 +107,10 @@ TEST(Cli, SameImageForEveryPath) {
             {"bvh_paired", {"--accel", "bvh", "--traversal", "paired", "--threads", "2", "--packet", "3"}},
             {"bvh_stream", {"--accel", "bvh", "--traversal", "stream", "--packet", "16"}},
             {"routed", {"--accel", "auto", "--threads", "2"}},
+            // --accel as the library's configuration string, options added to it.
+            {"kd_rec_spec", {"--accel", "kd:rec@leaf_size=2", "-P", "max_depth=20", "--packet", "5"}},
+            {"bih_portable_spec", {"--accel", "bih+portable", "--simd", "portable", "--packet", "7"}},
+            {"routed_spec", {"--accel", "auto@packets=bvh", "--threads", "2"}},
         };
         for (const auto& [name, extra] : paths) {
             const Image img = render(name, extra);
@@ -239,6 +243,16 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "--accel", "kd", "--threads", "2000"}, "--threads 2000 must lie in [0, 1024]"},
         {{"cache-study", spheres, "--threads", "5000", "--out", (dir.path / "study").string()},
          "--threads 5000 must lie in [0, 1024]"},
+        {{"info", spheres, "--accel", "kd:rec", "--traversal", "branched"},
+         "--traversal 'branched' contradicts --accel 'kd:rec'"},
+        {{"info", spheres, "--accel", "kd+sse", "--simd", "avx2"}, "--simd 'avx2' contradicts --accel 'kd+sse'"},
+        {{"render", spheres, "--accel", "kd@leaf_size=2", "-P", "leaf_size=3", "-o", out},
+         "--param 'leaf_size=3' contradicts --accel 'kd@leaf_size=2'"},
+        {{"info", spheres, "--accel", "kd@leaf_size"},
+         "--accel 'kd@leaf_size': accelerator parameter 'leaf_size' must have the form NAME=VALUE"},
+        {{"info", spheres, "--accel", "auto@packets=bvh,bvh_packets=off"},
+         "auto: bvh_packets=off contradicts packets=bvh, whose packets are the BVH's own (leave bvh_packets out, or "
+         "choose another tree for the packets)"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);
@@ -283,6 +297,31 @@ TEST(Cli, StatsOfAFileNamedInAnyBytes) {
     std::ifstream in(stats);
     const std::string json{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     EXPECT_NE(json.find("\"scene\": \"\xef\xbf\xbd\xef\xbf\xbd\""), std::string::npos) << json.substr(0, 200);
+}
+
+// --accel takes the configuration string the benchmarks, the C API and Python print: its traversal and
+// parameters reach the structure (the stats' report), as --traversal and -P do.
+TEST(Cli, AccelTakesTheLibrarysConfigurationString) {
+    TempDir dir;
+    auto figures = [&](std::vector<std::string> accel) {
+        const std::string stats = (dir.path / "stats.json").string();
+        std::vector<std::string> args{"render", "builtin:spheres?tris=100", "--size", "8x8", "--overwrite",
+                                      "-o", (dir.path / "x.png").string(), "--stats", stats};
+        args.insert(args.end(), accel.begin(), accel.end());
+        const auto [text, status] = run_for_error(args, dir.path);
+        EXPECT_EQ(status, 0) << text;
+        std::ifstream in(stats);
+        return std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    };
+    for (const std::vector<std::string>& accel : std::vector<std::vector<std::string>>{
+             {"--accel", "kd:branchless@max_depth=5"},
+             {"--accel", "kd", "--traversal", "branchless", "-P", "max_depth=5"},
+             {"--accel", "kd:branchless", "-P", "max_depth=5"}}) {
+        const std::string json = figures(accel);
+        EXPECT_NE(json.find("\"traversal\": \"branchless\""), std::string::npos) << accel[1] << ": " << json;
+        EXPECT_NE(json.find("\"depth limit\": \"5\""), std::string::npos) << accel[1] << ": " << json;
+        EXPECT_NE(json.find("\"simd lanes\": \"off\""), std::string::npos) << accel[1] << ": " << json;
+    }
 }
 
 }  // namespace
