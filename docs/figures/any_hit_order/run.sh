@@ -32,3 +32,13 @@ done
 bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_v3 --rounds 2 --json $D/ab_v1v3_frame.json -- \
   --scenes-dir ../shared/scenes --scenes sponza sibenik bunny 'builtin:forest?tris=200000' \
   --configs embree:single bvh:paired bvh:wide --size 256x256 --repeats 5 --builds 1 --clock cpu --rays frame
+# Not kept either: bench_v5, the closest-hit pushes reversed (pops largest box first); bench_s1, the
+# streams' any-hit keys by slot instead of distance.
+bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_v5 --rounds 2 --json $D/ab_v1v5_frame.json -- \
+  --scenes-dir ../shared/scenes --scenes sponza sibenik bunny 'builtin:forest?tris=200000' \
+  --configs embree:single bvh:paired --size 256x256 --repeats 5 --builds 1 --clock cpu --rays frame
+for rays in random ao; do
+  bench/ab_compare.py /tmp/ab/bench_v1 /tmp/ab/bench_s1 --rounds 2 --json $D/ab_stream_$rays.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:single bvh:stream \
+    --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $rays
+done
