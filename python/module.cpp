@@ -275,7 +275,11 @@ PYBIND11_MODULE(cellrt, m) {
         .def_property_readonly("config", [](const PyAccelerator& a) { return format_accel_config(a.config); },
                                "the configuration built, as one string (e.g. 'auto+auto@packets=bvh')")
         .def_property_readonly("device", [](const PyAccelerator& a) { return a.config.device; },
-                               "where it traces: 'cpu' or 'cuda'");
+                               "where it traces: 'cpu' or 'cuda'")
+        .def("__repr__", [](const PyAccelerator& a) {
+            return "<cellrt.Accelerator " + format_accel_config(a.config) + " on " + a.config.device + ", " +
+                   std::to_string(a.triangles.size()) + " triangles>";
+        });
 
     py::class_<Camera> camera(m, "Camera", "A pinhole camera: position, look_at, up, fov_y_deg (full vertical, degrees)");
     camera.def(py::init<>());

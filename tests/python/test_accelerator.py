@@ -193,6 +193,7 @@ def test_an_accelerator_names_its_configuration(city):
     assert default.config == "auto+auto@packets=bvh" and default.device == "cpu"
     kd = cellrt.Accelerator(city.triangles, kind="kd:rec", simd="off", params={"leaf_size": 2, "bins": 64})
     assert kd.config == "kd:rec@bins=64,leaf_size=2"
+    assert repr(kd) == "<cellrt.Accelerator kd:rec@bins=64,leaf_size=2 on cpu, %d triangles>" % len(city.triangles)
 
 
 def test_the_default_render_is_the_kd_trees_image_bit_for_bit(city):
