@@ -42,3 +42,5 @@ for rays in random ao; do
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:single bvh:stream \
     --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $rays
 done
+# Whole frames, old cellrt_scaling (5224d04, built in a worktree) against the new one:
+bench/frames_ab.sh $D/frames /tmp/ab/scaling_base
