@@ -108,6 +108,8 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             EXPECT_EQ(count(report, "\"tiles\""), static_cast<std::size_t>(ranks)) << report;
             EXPECT_NE(report.find("\"busy_seconds\""), std::string::npos);
             EXPECT_NE(report.find("\"float\""), std::string::npos) << report;
+            // Ranks on rank 0's machine (all here) write their pixels into its shared window.
+            EXPECT_NE(report.find("\"window_ranks\": " + std::to_string(ranks - 1)), std::string::npos) << report;
         }
         // A PNG's pixels travel as its 8-bit bytes, made on each rank: the plain program's PNG.
         const fs::path png = dir.path / (name + "plain.png");
@@ -121,6 +123,17 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             ASSERT_EQ(o.status, 0) << command << "\n" << o.err;
             EXPECT_EQ(read(out), read(png)) << c.options << ", " << ranks << " ranks, PNG";
             EXPECT_NE(read(stats).find("\"srgb8\""), std::string::npos) << read(stats);
+        }
+        // The pixels as messages, floats and PNG bytes: the same frames.
+        for (const char* ext : {".pfm", ".png"}) {
+            const fs::path out = dir.path / (name + "messages" + ext);
+            const fs::path stats = dir.path / (name + "messages" + ext + ".json");
+            const std::string command = mpirun(3) + mpi + " render " + frame + " --tile " + std::to_string(c.tile) +
+                                        " --gather messages -o " + out.string() + " --stats " + stats.string();
+            const Outcome o = shell(command, dir.path);
+            ASSERT_EQ(o.status, 0) << command << "\n" << o.err;
+            EXPECT_EQ(read(out), read(dir.path / (name + "plain" + ext))) << c.options << ", messages" << ext;
+            EXPECT_NE(read(stats).find("\"window_ranks\": 0"), std::string::npos) << read(stats);
         }
     }
 }
@@ -315,6 +328,25 @@ TEST_F(Distributed, ABadOptionIsOneMessage) {
     expect_failure(shell(mpirun(3) + mpi + " render " + kScene + " --packet 0 -o " + out.string(), dir.path), out,
                    "rank 0: ", "--packet 0 must lie in [1, 256]");
     expect_failure(shell(mpirun(2) + mpi + " info " + kScene, dir.path), out, "rank 0: ", "info runs in one process");
+}
+
+TEST_F(Distributed, WithoutSharedMemoryThePixelsTravelAsMessages) {
+    const std::string frame = std::string(kScene) + " --size 97x61";
+    const fs::path reference = dir.path / "plain.pfm";
+    ASSERT_EQ(shell(plain + " render " + frame + " -o " + reference.string(), dir.path).status, 0);
+    // Rank 0 cannot make the memory, or rank 2 cannot map it: every rank sends its pixels, and rank 0
+    // says so in one line.
+    for (const char* fault : {"noshm:0", "noshm:2"}) {
+        const fs::path out = dir.path / (std::string(fault + 6) + ".pfm");
+        const fs::path stats = dir.path / (std::string(fault + 6) + ".json");
+        const Outcome o = shell(mpirun(3, std::string("-x CELLRT_MPI_FAULT=") + fault) + mpi + " render " + frame +
+                                    " --tile 16 -o " + out.string() + " --stats " + stats.string(),
+                                dir.path);
+        ASSERT_EQ(o.status, 0) << fault << "\n" << o.err;
+        EXPECT_EQ(read(out), read(reference)) << fault;
+        EXPECT_NE(read(stats).find("\"window_ranks\": 0"), std::string::npos) << read(stats);
+        EXPECT_EQ(count(o.err, "cellrt: note: no shared memory for the tiles' pixels"), 1u) << o.err;
+    }
 }
 
 TEST_F(Distributed, ARankThatDiesEndsTheJob) {

@@ -164,20 +164,21 @@ run)
   export run frames
   plain="cellrt render $sponza"
   mpi="mpirun --oversubscribe --bind-to none"
-  # 16 ranks against one process. mpi16_cma asks Open MPI for its single-copy transport by name: it
-  # says so where the machine refuses it (yama's ptrace_scope, or a container without ptrace).
+  # 16 ranks against one process: the pixels through rank 0's shared window (the default) and as
+  # messages, the way before it. mpi16_messages_cma asks Open MPI for its single-copy transport by
+  # name: it says so where the machine refuses it (yama's ptrace_scope, or a container without ptrace).
   if [[ -x "$dir/bundle/bin/cellrt-mpi" ]] && wanted mpi16; then
     cat /proc/sys/kernel/yama/ptrace_scope > "$res/mpi/ptrace_scope.txt" 2>&1 || true
     timed mpi16 90 bash -c 'mpi_rounds "$@"' _ "$res/mpi" "plain_t16=$plain --threads 16" \
       "plain_t1=$plain --threads 1" "mpi16=$mpi -np 16 cellrt-mpi render $sponza --threads 1" \
       "mpi16_tile64=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 64" \
-      "mpi8x2=$mpi -np 8 cellrt-mpi render $sponza --threads 2" \
-      "mpi16_cma=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1"
-    # The same frame written as PNG: the ranks send 8-bit pixels, a quarter of the floats' bytes.
+      "mpi16_messages=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --gather messages" \
+      "mpi16_messages_cma=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1 --gather messages"
+    # The same frame written as PNG: the ranks make 8-bit pixels, a quarter of the floats' bytes.
     export FRAME_EXT=png
     timed mpi16_png 60 bash -c 'mpi_rounds "$@"' _ "$res/mpi_png" "plain_t16=$plain --threads 16" \
       "plain_t1=$plain --threads 1" "mpi16=$mpi -np 16 cellrt-mpi render $sponza --threads 1" \
-      "mpi16_tile64=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 64"
+      "mpi16_messages=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --gather messages"
     unset FRAME_EXT
   fi
   # What holds 16 ranks back (not by default): tiles held ahead, tile edge, binding, ranks, transport.
@@ -189,7 +190,7 @@ run)
       "mpi16_tile256=$mpi -np 16 cellrt-mpi render $sponza --threads 1 --tile 256" \
       "mpi16_core=mpirun --oversubscribe --bind-to core -np 16 cellrt-mpi render $sponza --threads 1" \
       "mpi15=$mpi -np 15 cellrt-mpi render $sponza --threads 1" \
-      "mpi16_cma_ahead6=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1 --ahead 6" \
+      "mpi16_messages_cma_ahead6=$mpi --mca btl_vader_single_copy_mechanism cma -np 16 cellrt-mpi render $sponza --threads 1 --ahead 6 --gather messages" \
       "mpi4x4=$mpi -np 4 cellrt-mpi render $sponza --threads 4"
   fi
   # Last, as the step a short call may cut: asynchronous access, whose touches reach the node cache only.

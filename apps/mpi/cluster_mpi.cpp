@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "cluster.hpp"
@@ -22,6 +23,7 @@ std::unique_ptr<distributed::Session> g_session;
 struct Options {
     bool broadcast_scene = false;
     distributed::TileOptions tiles;
+    std::string gather = "window";
 };
 Options g_options;
 
@@ -82,6 +84,11 @@ void add_render_options(CLI::App& cmd) {
                    "Tiles each rank holds: the one it traces and those queued behind it")
         ->capture_default_str()
         ->check(CLI::Range(1, distributed::kMaxAhead));
+    cmd.add_option("--gather", g_options.gather,
+                   "How the ranks' pixels reach rank 0: window (ranks on rank 0's machine write them into memory "
+                   "it shares with them, the others send them) or messages (every rank sends them)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"window", "messages"}));
 }
 
 void add_sweep_options(CLI::App& cmd) { add_common_options(cmd, kLongestRankTimeout); }
@@ -98,11 +105,14 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     std::vector<distributed::RankLoad> loads;
     distributed::TileOptions tiles = g_options.tiles;
     tiles.srgb8 = png;
+    tiles.gather = g_options.gather == "messages" ? distributed::TileGather::messages : distributed::TileGather::window;
     distributed::render_tiles(session(), scene, accel, options, tiles, frame, &stats, &loads);
     if (!leader()) return;
     report["tile"] = tiles.tile;
     report["ahead"] = tiles.ahead;
     report["pixels"] = tiles.srgb8 ? "srgb8" : "float";
+    report["gather"] = g_options.gather;
+    report["window_ranks"] = loads.empty() ? 0 : loads[0].window_writers;
     report["scene_from"] = g_options.broadcast_scene ? "broadcast" : "path";
     report["ranks"] = nlohmann::json::array();
     for (std::size_t r = 0; r < loads.size(); ++r) {

@@ -19,6 +19,7 @@
 #include <variant>
 
 #include "core/timer.hpp"
+#include "distributed/tile_window.hpp"
 
 namespace cellrt::distributed {
 namespace {
@@ -69,14 +70,43 @@ struct TileGrid {
 // Bytes a pixel takes on the way to rank 0.
 std::size_t pixel_bytes(bool as_srgb8) { return as_srgb8 ? 3 : sizeof(Vec3); }
 
-// A traced tile's pixels as they travel: its floats, or each channel's PNG byte.
-void append_pixels(std::string& bytes, const Image& tile, bool as_srgb8) {
+// The most pixels a tile of `grid` holds.
+std::size_t max_tile_pixels(const TileGrid& grid) {
+    std::size_t most = 0;
+    for (std::size_t t = 0; t < grid.count(); ++t) most = std::max(most, static_cast<std::size_t>(grid.rect(t).pixels()));
+    return most;
+}
+
+// How a traced tile's pixels reach rank 0: their form, and for the ranks that write them into the
+// shared window, where. A writer's area holds `ahead` tiles, a slot each, used in turn: its n-th
+// tile goes to slot n mod ahead. That slot last held its tile n - ahead, which rank 0 read before it
+// sent the answer that handed the rank tile n (the answers arrive in order: one per tile returned,
+// after `ahead` at the start), so no write overtakes a read.
+struct TilePixels {
+    bool srgb8;
+    int ahead;
+    std::size_t slot_bytes;
+    const TileWindow& window;
+
+    char* slot(char* area, std::uint64_t n) const {
+        return area + slot_bytes * static_cast<std::size_t>(n % static_cast<std::uint64_t>(ahead));
+    }
+};
+
+// A traced tile's pixels as they travel, written to `to`: its floats, or each channel's PNG byte.
+void write_pixels(char* to, const Image& tile, bool as_srgb8) {
     if (!as_srgb8) {
-        bytes.append(reinterpret_cast<const char*>(tile.pixels.data()), tile.pixels.size() * sizeof(Vec3));
+        std::memcpy(to, tile.pixels.data(), tile.pixels.size() * sizeof(Vec3));
         return;
     }
     const Srgb8Image rgb = to_srgb8(tile);
-    bytes.append(reinterpret_cast<const char*>(rgb.rgb.data()), rgb.rgb.size());
+    std::memcpy(to, rgb.rgb.data(), rgb.rgb.size());
+}
+// The same bytes, appended to a message.
+void append_pixels(std::string& bytes, const Image& tile, bool as_srgb8) {
+    const std::size_t at = bytes.size();
+    bytes.resize(at + tile.pixels.size() * pixel_bytes(as_srgb8));
+    write_pixels(bytes.data() + at, tile, as_srgb8);
 }
 
 // Puts a tile's travelled pixels (its rect's rows, packed) in their place in the frame.
@@ -181,15 +211,16 @@ std::unique_ptr<FrameRenderer> start_renderer(const Scene& scene, const Accelera
     }
 }
 
-// A rank other than 0: traces the tiles rank 0 hands it and returns each one's pixels; one more
-// answer is owed for every tile returned and `ahead` at the start, until rank 0 answers that none is
-// left. A thread of its own traces while this one, the only one that calls MPI, polls: a tile's
-// pixels exceed the eager limit of MPI's shared-memory and network transports, so they travel in
-// fragments that move only while the sender calls MPI. A rank that called MPI only between tiles
-// sent each tile's last fragments a tile or more late and waited for its next tile (with Open MPI
-// and no single-copy transport, 16 ranks on one machine: busy 40 % of the frame; docs/DISTRIBUTED.md).
+// A rank other than 0: traces the tiles rank 0 hands it and returns each one's pixels (in its area of
+// the shared window, with a header that says so, or in the message); one more answer is owed for
+// every tile returned and `ahead` at the start, until rank 0 answers that none is left. A thread of
+// its own traces while this one, the only one that calls MPI, polls: a tile's pixels sent as a message
+// exceed the eager limit of MPI's shared-memory and network transports, so they travel in fragments
+// that move only while the sender calls MPI. A rank that called MPI only between tiles sent each
+// tile's last fragments a tile or more late and waited for its next tile (with Open MPI and no
+// single-copy transport, 16 ranks on one machine: busy 40 % of the frame; docs/DISTRIBUTED.md).
 RankLoad trace_for_master(const Session& session, const Scene& scene, const Accelerator& accel,
-                          const RenderOptions& options, const TileGrid& grid, int ahead, bool as_srgb8,
+                          const RenderOptions& options, const TileGrid& grid, int ahead, const TilePixels& pixels,
                           std::optional<std::string>& failure) {
     const RenderOptions o = tile_options(options);
     RankLoad load;
@@ -206,6 +237,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     std::thread tracer([&] {
         Image tile;
         const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
+        std::uint64_t sequence = 0;  // tiles taken from the queue
         for (bool first = true;; first = false) {
             std::int32_t t = kNoTile;
             {
@@ -216,6 +248,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
                 queue.pop_front();
                 if (queue.empty()) returned.notify_one();  // time to look for the next tiles
             }
+            const std::uint64_t n = sequence++;
             if (first) inject_fault(session.rank());
             std::string bytes(sizeof(ResultHeader), '\0');
             ResultHeader header{t, Outcome::skipped, 0.0};
@@ -226,7 +259,8 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
                     add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
                     header.outcome = Outcome::traced;
                     header.seconds = s.seconds;
-                    append_pixels(bytes, tile, as_srgb8);
+                    if (pixels.window.writes()) write_pixels(pixels.slot(pixels.window.mine(), n), tile, pixels.srgb8);
+                    else append_pixels(bytes, tile, pixels.srgb8);
                 } catch (const std::exception& e) {
                     failure = e.what();
                     header.outcome = Outcome::failed;
@@ -253,6 +287,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
             const std::lock_guard lock(mutex);
             ready.swap(traced);
         }
+        if (!ready.empty()) pixels.window.sync();  // the tracer's pixels before their headers
         for (std::string& bytes : ready) {
             outbox.send(std::move(bytes), 0, kTagResult);
             ++pending;
@@ -299,7 +334,8 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
 // Rank 0: hands out tiles and gathers them into `frame` (in the pixels of the alternative it holds),
 // while a thread of its own traces tiles too.
 RankLoad master(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
-                const TileGrid& grid, int ahead, TileFrame& frame, std::optional<std::string>& failure) {
+                const TileGrid& grid, int ahead, const TilePixels& pixels, TileFrame& frame,
+                std::optional<std::string>& failure) {
     const auto ranks = static_cast<std::size_t>(session.size());
     const std::size_t count = grid.count();
     std::size_t all_packets = 0;
@@ -344,6 +380,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
     Outbox outbox;
     std::vector<std::size_t> outstanding(ranks, 0);
     std::vector<double> heard(ranks, 0.0), tile_time(ranks, 0.0);  // last result; a tile's mean time
+    std::vector<std::uint64_t> results(ranks, 0);  // results received, by rank
     // The master polls often enough to answer a rank before its queued tiles run out, and no more
     // often: a poll costs some 25 us of rank 0's cores (docs/DISTRIBUTED.md). The ranks' own tracing
     // times set it, not the gaps between their results, which grow when a rank waits. A tile's pixels
@@ -359,11 +396,11 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         const double seconds = std::clamp(fastest * (ahead - 1) / 8.0, 100e-6, 2e-3);
         return std::chrono::microseconds(static_cast<long long>(seconds * 1e6));
     };
-    std::size_t max_tile_pixels = 0;
-    for (std::size_t t = 0; t < count; ++t)
-        max_tile_pixels = std::max(max_tile_pixels, static_cast<std::size_t>(grid.rect(t).pixels()));
-    const std::size_t buffer_bytes =
-        sizeof(ResultHeader) + std::max(max_tile_pixels * pixel_bytes(std::holds_alternative<Srgb8Image>(frame)), kMaxCause);
+    // A rank that writes into the window sends only a header, or a failed tile's cause.
+    std::vector<int> buffer_bytes(ranks, 0);
+    for (std::size_t r = 1; r < ranks; ++r)
+        buffer_bytes[r] = static_cast<int>(
+            sizeof(ResultHeader) + std::max(pixels.window.written_by(static_cast<int>(r)) ? 0 : pixels.slot_bytes, kMaxCause));
     std::vector<std::string> buffers(ranks);
     std::vector<MPI_Request> requests(ranks, MPI_REQUEST_NULL);
     auto answer = [&](std::size_t r) {
@@ -372,10 +409,10 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         if (t != kNoTile) ++outstanding[r];
     };
     for (std::size_t r = 1; r < ranks; ++r) {
-        buffers[r].resize(buffer_bytes);
+        buffers[r].resize(static_cast<std::size_t>(buffer_bytes[r]));
         for (int a = 0; a < ahead; ++a) answer(r);
         if (outstanding[r] > 0)
-            MPI_Irecv(buffers[r].data(), static_cast<int>(buffer_bytes), MPI_BYTE, static_cast<int>(r), kTagResult,
+            MPI_Irecv(buffers[r].data(), buffer_bytes[r], MPI_BYTE, static_cast<int>(r), kTagResult,
                       MPI_COMM_WORLD, &requests[r]);
     }
     std::vector<int> indices(ranks);
@@ -388,24 +425,29 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         if (remote)
             MPI_Testsome(static_cast<int>(ranks), requests.data(), &completed, indices.data(), MPI_STATUSES_IGNORE);
         if (completed == MPI_UNDEFINED) completed = 0;
+        if (completed > 0) pixels.window.sync();  // the pixels of the headers received, before reading
         for (int i = 0; i < completed; ++i) {
             const auto r = static_cast<std::size_t>(indices[static_cast<std::size_t>(i)]);
             ResultHeader header;
             std::memcpy(&header, buffers[r].data(), sizeof header);
             --outstanding[r];
+            const std::uint64_t n = results[r]++;
             heard[r] = frame_timer.seconds();
             if (header.outcome == Outcome::traced)
                 tile_time[r] = tile_time[r] > 0.0 ? 0.75 * tile_time[r] + 0.25 * header.seconds : header.seconds;
             if (header.outcome == Outcome::traced) {
                 const auto t = static_cast<std::size_t>(header.tile);
-                copy_into(frame, grid.rect(t), buffers[r].data() + sizeof header);
+                const bool shared = pixels.window.written_by(static_cast<int>(r));
+                copy_into(frame, grid.rect(t),
+                          shared ? pixels.slot(pixels.window.of(static_cast<int>(r)), n) : buffers[r].data() + sizeof header);
+                if (shared) pixels.window.sync();  // the slot read before the answer frees it
                 gathered += grid.packets(t);
             } else if (header.outcome == Outcome::failed) {
                 stop = true;  // the rank reports its cause itself when the ranks agree
             }
             answer(r);
             if (outstanding[r] > 0)
-                MPI_Irecv(buffers[r].data(), static_cast<int>(buffer_bytes), MPI_BYTE, static_cast<int>(r), kTagResult,
+                MPI_Irecv(buffers[r].data(), buffer_bytes[r], MPI_BYTE, static_cast<int>(r), kTagResult,
                           MPI_COMM_WORLD, &requests[r]);
         }
         const double now = frame_timer.seconds();
@@ -435,6 +477,7 @@ std::string load_bytes(const RankLoad& load) {
     put(load.seconds);
     put(load.cpu_seconds);
     put(load.master_cpu_seconds);
+    put(load.window_writers);
     for (const WorkerLoad& w : load.workers) {
         put(w.packets);
         put(w.busy_seconds);
@@ -457,6 +500,7 @@ RankLoad parse_load(const std::string& bytes) {
     get(load.seconds);
     get(load.cpu_seconds);
     get(load.master_cpu_seconds);
+    get(load.window_writers);
     while (at + sizeof(std::size_t) + sizeof(double) <= bytes.size()) {
         WorkerLoad w;
         get(w.packets);
@@ -490,13 +534,18 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
     std::optional<std::string> failure;
     Timer timer;
     RankLoad mine;
+    const std::size_t slot_bytes = max_tile_pixels(grid) * pixel_bytes(tiles.srgb8);
+    TileWindow window(session, tiles.gather == TileGather::window, slot_bytes * static_cast<std::size_t>(tiles.ahead));
+    const TilePixels pixels{tiles.srgb8, tiles.ahead, slot_bytes, window};
     if (session.leader()) {
         if (tiles.srgb8) frame = Srgb8Image(options.width, options.height);
         else frame = Image(options.width, options.height);
-        mine = master(session, scene, accel, options, grid, tiles.ahead, frame, failure);
+        mine = master(session, scene, accel, options, grid, tiles.ahead, pixels, frame, failure);
+        mine.window_writers = window.writers();
     } else {
-        mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, tiles.srgb8, failure);
+        mine = trace_for_master(session, scene, accel, options, grid, tiles.ahead, pixels, failure);
     }
+    window.close();
     const double seconds = timer.seconds();
     session.agree(failure, "the frame");
     const std::vector<std::string> all = session.gather(load_bytes(mine), "the ranks' figures");

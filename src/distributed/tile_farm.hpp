@@ -3,7 +3,8 @@
 // each rank `ahead` tiles at the start and one more for every tile a rank returns, so a rank always
 // has the next tile at hand while its last result travels (asking ahead); it gathers the tiles into
 // the frame. Every rank, rank 0 included (on a thread of its own beside the master), traces a tile
-// on all its cores through the process's scheduler (FrameRenderer::render_window). A pixel's colour
+// on all its cores through the process's scheduler (FrameRenderer::render_window). Ranks on rank 0's
+// machine hand their pixels over through shared memory (tile_window.hpp). A pixel's colour
 // depends only on its own rays, so the frame is the one-process frame, bit for bit, for every number
 // of ranks.
 #pragma once
@@ -19,12 +20,18 @@
 
 namespace cellrt::distributed {
 
+// How the ranks' pixels reach rank 0. window: the ranks on rank 0's machine write them into memory it
+// shares with them (distributed/tile_window.hpp) and send only each tile's header; ranks on other
+// machines send them. messages: every rank sends them.
+enum class TileGather { window, messages };
+
 struct TileOptions {
     int tile = 128;  // tile edge in pixels (the frame's edge tiles are cut to it)
     int ahead = 3;   // tiles a rank holds: the one it traces and those queued behind it
     // Tiles travel as 8-bit sRGB pixels, 3 bytes where floats take 12: for a frame written as PNG,
     // whose bytes each rank makes from its own pixels as the PNG writer would (cellrt/image.hpp).
     bool srgb8 = false;
+    TileGather gather = TileGather::window;
 };
 
 // The frame rank 0 gathers: linear floats, or with TileOptions::srgb8 the PNG's 8-bit pixels.
@@ -40,6 +47,7 @@ struct RankLoad {
     double seconds = 0.0;          // from the frame's start on this rank until it had no tile left
     double cpu_seconds = 0.0;      // the process's CPU time in that span, every thread's
     double master_cpu_seconds = 0.0;  // rank 0: its master thread's share of it
+    int window_writers = 0;           // rank 0: the ranks that wrote their pixels into the shared window
     std::vector<WorkerLoad> workers;  // its threads' packets and time tracing, summed over its tiles
 };
 
