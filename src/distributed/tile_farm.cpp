@@ -264,6 +264,7 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
                 } catch (const std::exception& e) {
                     failure = e.what();
                     header.outcome = Outcome::failed;
+                    bytes.resize(sizeof(ResultHeader));  // no pixels half written before the cause
                     bytes.append(failure->substr(0, kMaxCause));
                 }
             }
@@ -331,8 +332,8 @@ RankLoad trace_for_master(const Session& session, const Scene& scene, const Acce
     return load;
 }
 
-// Rank 0: hands out tiles and gathers them into `frame` (in the pixels of the alternative it holds),
-// while a thread of its own traces tiles too.
+// Rank 0: hands out tiles and gathers them into `frame`, which it makes (floats, or the PNG's bytes
+// with pixels.srgb8), while a thread of its own traces tiles too.
 RankLoad master(const Session& session, const Scene& scene, const Accelerator& accel, const RenderOptions& options,
                 const TileGrid& grid, int ahead, const TilePixels& pixels, TileFrame& frame,
                 std::optional<std::string>& failure) {
@@ -350,31 +351,6 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
         const std::size_t t = next.fetch_add(1);
         return t < count ? static_cast<std::int32_t>(t) : kNoTile;
     };
-
-    // Rank 0's own tiles, claimed from the same counter; the thread never calls MPI.
-    const RenderOptions o = tile_options(options);
-    RankLoad load;
-    load.threads = o.threads;
-    std::thread local([&] {
-        Image tile;
-        const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
-        if (!renderer) stop = true;
-        for (std::int32_t t = claim(); t != kNoTile; t = claim()) {
-            try {
-                RenderStats s;
-                const PixelRect r = grid.rect(static_cast<std::size_t>(t));
-                renderer->render_window(r, tile, &s);
-                copy_into(frame, r, tile);
-                add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
-                gathered += grid.packets(static_cast<std::size_t>(t));
-            } catch (const std::exception& e) {
-                failure = e.what();
-                stop = true;
-            }
-        }
-        load.seconds = frame_timer.seconds();
-        local_done = true;
-    });
 
     // The other ranks' tiles: `ahead` each at the start, then one per tile returned.
     Outbox outbox;
@@ -415,6 +391,37 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
             MPI_Irecv(buffers[r].data(), buffer_bytes[r], MPI_BYTE, static_cast<int>(r), kTagResult,
                       MPI_COMM_WORLD, &requests[r]);
     }
+
+    // The frame, made once the other ranks have their first tiles: zeroing 25 MB of 1080p floats
+    // takes some 5 ms, which they would otherwise wait out before starting.
+    if (pixels.srgb8) frame = Srgb8Image(grid.width, grid.height);
+    else frame = Image(grid.width, grid.height);
+
+    // Rank 0's own tiles, claimed from the same counter; the thread never calls MPI.
+    const RenderOptions o = tile_options(options);
+    RankLoad load;
+    load.threads = o.threads;
+    std::thread local([&] {
+        Image tile;
+        const std::unique_ptr<FrameRenderer> renderer = start_renderer(scene, accel, o, failure);
+        if (!renderer) stop = true;
+        for (std::int32_t t = claim(); t != kNoTile; t = claim()) {
+            try {
+                RenderStats s;
+                const PixelRect r = grid.rect(static_cast<std::size_t>(t));
+                renderer->render_window(r, tile, &s);
+                copy_into(frame, r, tile);
+                add_tile(load, s, grid.packets(static_cast<std::size_t>(t)));
+                gathered += grid.packets(static_cast<std::size_t>(t));
+            } catch (const std::exception& e) {
+                failure = e.what();
+                stop = true;
+            }
+        }
+        load.seconds = frame_timer.seconds();
+        local_done = true;
+    });
+
     std::vector<int> indices(ranks);
     const double timeout = static_cast<double>(session.timeout().count()) / 1e3;
     std::size_t reported = 0;
@@ -535,11 +542,11 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
     Timer timer;
     RankLoad mine;
     const std::size_t slot_bytes = max_tile_pixels(grid) * pixel_bytes(tiles.srgb8);
-    TileWindow window(session, tiles.gather == TileGather::window, slot_bytes * static_cast<std::size_t>(tiles.ahead));
+    TileWindow window(session, tiles.gather == TileGather::window, slot_bytes * static_cast<std::size_t>(tiles.ahead),
+                      static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height) *
+                          pixel_bytes(tiles.srgb8));
     const TilePixels pixels{tiles.srgb8, tiles.ahead, slot_bytes, window};
     if (session.leader()) {
-        if (tiles.srgb8) frame = Srgb8Image(options.width, options.height);
-        else frame = Image(options.width, options.height);
         mine = master(session, scene, accel, options, grid, tiles.ahead, pixels, frame, failure);
         mine.window_writers = window.writers();
     } else {

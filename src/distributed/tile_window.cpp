@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <mpi.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,11 +20,20 @@ namespace {
 
 constexpr std::size_t kNameBytes = 64;
 
-// The test suite's way to deny a rank the shared memory (tests/test_distributed.cpp):
-// CELLRT_MPI_FAULT=noshm:R.
-bool denied(int rank) {
-    const char* fault = std::getenv("CELLRT_MPI_FAULT");
-    return fault && std::strncmp(fault, "noshm:", 6) == 0 && std::atoi(fault + 6) == rank;
+// The most memory the window takes: a frame's pixels, or this much where the frame's are fewer.
+// Beyond it (huge tiles held far ahead by many ranks) the pixels travel as messages.
+constexpr std::size_t kMostShared = std::size_t{1} << 30;
+
+// The test suite's ways to deny a rank the shared memory, or to seat it on a machine of its own
+// (tests/test_distributed.cpp): CELLRT_MPI_FAULT=noshm:R or apart:R.
+bool fault(const char* kind, int rank) {
+    const char* f = std::getenv("CELLRT_MPI_FAULT");
+    const std::size_t n = std::strlen(kind);
+    return f && std::strncmp(f, kind, n) == 0 && f[n] == ':' && std::atoi(f + n + 1) == rank;
+}
+bool any_fault(const char* kind) {
+    const char* f = std::getenv("CELLRT_MPI_FAULT");
+    return f && std::strncmp(f, kind, std::strlen(kind)) == 0;
 }
 
 // Rank 0: makes the shared object `name` of `bytes` and maps it; null with `why` set when it cannot.
@@ -45,22 +55,33 @@ char* make_shared(const char* name, std::size_t bytes, std::string& why) {
     return p == MAP_FAILED ? nullptr : static_cast<char*>(p);
 }
 
-// Another rank: maps rank 0's object, or null.
+// Another rank: maps rank 0's object, or null; null too where it is smaller than this rank expects
+// (ranks started with other options), whose stores past its end would raise SIGBUS.
 char* map_shared(const char* name, std::size_t bytes) {
     const int fd = shm_open(name, O_RDWR, 0600);
     if (fd < 0) return nullptr;
-    void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    struct stat st {};
+    void* p = MAP_FAILED;
+    if (fstat(fd, &st) == 0 && static_cast<std::size_t>(st.st_size) == bytes)
+        p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
     ::close(fd);
     return p == MAP_FAILED ? nullptr : static_cast<char*>(p);
 }
 
 }  // namespace
 
-TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_each) : bytes_each_(bytes_each) {
+TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_each, std::size_t frame_bytes)
+    : bytes_each_(bytes_each) {
     if (!wanted || session.size() < 2 || bytes_each == 0) return;
     // The ranks of each machine, in world order: the first of rank 0's machine is rank 0.
     MPI_Comm machine = MPI_COMM_NULL;
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, session.rank(), MPI_INFO_NULL, &machine);
+    if (any_fault("apart")) {
+        MPI_Comm apart = MPI_COMM_NULL;
+        MPI_Comm_split(machine, fault("apart", session.rank()) ? 1 : 0, session.rank(), &apart);
+        MPI_Comm_free(&machine);
+        machine = apart;
+    }
     int first = session.rank(), sharing = 0, here = 0;
     MPI_Bcast(&first, 1, MPI_INT, 0, machine);
     MPI_Comm_size(machine, &sharing);
@@ -70,6 +91,10 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
         return;
     }
     const std::size_t bytes = bytes_each * static_cast<std::size_t>(sharing - 1);
+    if (bytes > std::max(frame_bytes, kMostShared)) {
+        MPI_Comm_free(&machine);
+        return;
+    }
     // Rank 0 makes the object and names it to the others ('\0' first: it could not).
     static unsigned frames = 0;
     char name[kNameBytes] = {};
@@ -77,12 +102,12 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
     char* base = nullptr;
     if (session.leader()) {
         std::snprintf(name, sizeof name, "/cellrt-tiles-%ld-%u", static_cast<long>(getpid()), frames++);
-        base = denied(0) ? nullptr : make_shared(name, bytes, why);
-        if (denied(0)) why = "denied by CELLRT_MPI_FAULT";
+        base = fault("noshm", 0) ? nullptr : make_shared(name, bytes, why);
+        if (fault("noshm", 0)) why = "denied by CELLRT_MPI_FAULT";
         if (!base) name[0] = '\0';
     }
     MPI_Bcast(name, static_cast<int>(sizeof name), MPI_CHAR, 0, machine);
-    if (name[0] != '\0' && !session.leader() && !denied(session.rank())) base = map_shared(name, bytes);
+    if (name[0] != '\0' && !session.leader() && !fault("noshm", session.rank())) base = map_shared(name, bytes);
     int mapped = base != nullptr, all_mapped = 0;
     MPI_Allreduce(&mapped, &all_mapped, 1, MPI_INT, MPI_MIN, machine);
     if (session.leader() && name[0] != '\0') shm_unlink(name);  // every rank has it mapped, or has given up

@@ -11,7 +11,8 @@
 // MPI_Win_allocate_shared hangs or ends the job when the machine's shared memory cannot hold the
 // segment, where this one is made and checked (posix_fallocate) by rank 0 alone, and the ranks agree
 // to go without it. Its name is unlinked as soon as every rank has mapped it, so nothing is left
-// behind in /dev/shm, whatever happens later.
+// behind in /dev/shm, whatever happens later (a rank 0 killed in the moment between making and
+// unlinking it would leave it).
 //
 // Ordering: a writer stores, calls sync() and then sends the header; rank 0 receives the header,
 // calls sync(), reads, calls sync() again and only then tells the writer that the slot is free (the
@@ -29,10 +30,11 @@ namespace cellrt::distributed {
 class TileWindow {
 public:
     // Collective over MPI_COMM_WORLD, every rank with the same arguments: with `wanted` and more than
-    // one rank, each other rank on rank 0's machine gets `bytes_each` of memory shared with rank 0.
-    // When the machine cannot give them, rank 0 says so in one line and every rank goes without: its
-    // pixels travel as messages.
-    TileWindow(const Session& session, bool wanted, std::size_t bytes_each);
+    // one rank, each other rank on rank 0's machine gets `bytes_each` of memory shared with rank 0,
+    // unless they come to more than the frame's `frame_bytes` and 1 GiB. When the machine cannot give
+    // them, rank 0 says so in one line and every rank goes without: its pixels travel as messages.
+    // The calls are MPI's blocking collectives (no time-out): every rank makes them before its tiles.
+    TileWindow(const Session& session, bool wanted, std::size_t bytes_each, std::size_t frame_bytes);
     ~TileWindow() { close(); }
     TileWindow(const TileWindow&) = delete;
     TileWindow& operator=(const TileWindow&) = delete;
