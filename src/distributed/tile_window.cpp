@@ -91,16 +91,14 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
         return;
     }
     const std::size_t bytes = bytes_each * static_cast<std::size_t>(sharing - 1);
-    if (bytes > std::max(frame_bytes, kMostShared)) {
-        MPI_Comm_free(&machine);
-        return;
-    }
-    // Rank 0 makes the object and names it to the others ('\0' first: it could not).
+    const bool fits = bytes <= std::max(frame_bytes, kMostShared);
+    // Rank 0 makes the object and names it to the others ('\0' first: it did not, or could not).
+    // Rank 0 alone decides, so that ranks started with other options cannot take other ways here.
     static unsigned frames = 0;
     char name[kNameBytes] = {};
     std::string why;
     char* base = nullptr;
-    if (session.leader()) {
+    if (session.leader() && fits) {
         std::snprintf(name, sizeof name, "/cellrt-tiles-%ld-%u", static_cast<long>(getpid()), frames++);
         base = fault("noshm", 0) ? nullptr : make_shared(name, bytes, why);
         if (fault("noshm", 0)) why = "denied by CELLRT_MPI_FAULT";
@@ -113,7 +111,7 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
     if (session.leader() && name[0] != '\0') shm_unlink(name);  // every rank has it mapped, or has given up
     if (!all_mapped) {
         if (base) munmap(base, bytes);
-        if (session.leader())
+        if (session.leader() && fits)
             std::fprintf(stderr, "%s: note: no shared memory for the tiles' pixels (%zu bytes%s%s); the ranks send them\n",
                          session.program().c_str(), bytes, why.empty() ? ", a rank could not map them" : ": ",
                          why.c_str());
