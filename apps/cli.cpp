@@ -30,14 +30,16 @@ void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
                        ", or a whole configuration KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...] as the benchmarks, the C "
                        "API and Python name it (the options below add to it)")
         ->capture_default_str();
-    cmd.add_option("--traversal", traversal,
+    traversal_option = cmd.add_option("--traversal", traversal,
                    "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|paired|stream|packet); "
-                   "implies --simd off");
+                   "implies --simd off")
+                           ->check(non_empty());
     simd_option = cmd.add_option("--simd", simd,
                                  "SIMD ray packets: auto|off|portable|sse|avx2|avx512 (docs/PACKETS.md)")
                       ->capture_default_str();
-    cmd.add_option("-P,--param", params, "Build parameter NAME=VALUE (repeatable; docs/KDTREE.md, docs/BIH.md)");
-    cmd.add_option("--threads", threads, "Worker and build threads (0: all cores)")->capture_default_str();
+    params_option =
+        cmd.add_option("-P,--param", params, "Build parameter NAME=VALUE (repeatable; docs/KDTREE.md, docs/BIH.md)");
+    threads_option = cmd.add_option("--threads", threads, "Worker and build threads (0: all cores)")->capture_default_str();
     if (with_device)
         cmd.add_option("--device", device, "Where rays are traced: cpu, or cuda (kd and bih on the GPU; docs/GPU.md)")
             ->check(CLI::IsMember({"cpu", "cuda"}))
@@ -70,18 +72,38 @@ AccelConfig AccelOptions::config() const {
     }
     c.device = device;
     c.threads = threads;
+    const AccelConfig named = c;  // what --accel set
     for (const std::string& p : params) {
         const auto eq = p.find('=');
         if (eq == std::string::npos || eq == 0) throw Error("--param '" + p + "' must have the form NAME=VALUE");
         const std::string name = p.substr(0, eq), value = p.substr(eq + 1);
-        if (const auto it = c.params.find(name); it != c.params.end() && it->second != value)
-            throw contradiction("--param '" + p + "'");
+        if (const auto it = c.params.find(name); it != c.params.end() && it->second != value) {
+            if (named.params.count(name)) throw contradiction("--param '" + p + "'");
+            throw Error("--param '" + p + "' contradicts --param '" + name + "=" + it->second + "'");
+        }
         c.params[name] = value;
     }
     return c;
 }
 
-std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config) {
+bool AccelOptions::describes_structure() const {
+    for (const CLI::Option* o : {simd_option, traversal_option, params_option, threads_option})
+        if (o && o->count() > 0) return true;
+    return false;
+}
+
+std::string AccelOptions::simd_source() const {
+    const bool simd_named = kind.substr(0, kind.find('@')).find('+') != std::string::npos;
+    return simd_named ? "--accel '" + kind + "'" : "--simd";
+}
+
+CLI::Validator non_empty() {
+    return CLI::Validator([](const std::string& s) { return s.empty() ? std::string("must not be empty") : std::string(); },
+                          "", "NONEMPTY");
+}
+
+std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
+                                             const std::string& simd_source) {
     try {
         return make_accelerator(triangles, config);
     } catch (const Error&) {
@@ -89,7 +111,7 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
         try {
             detail::parse_isa(config.simd);
         } catch (const Error& e) {
-            throw Error(std::string("--simd: ") + e.what());
+            throw Error(simd_source + ": " + e.what());
         }
         throw;
     }
@@ -99,6 +121,26 @@ void check_output(const std::string& path, bool overwrite) {
     std::error_code ec;  // a path the system cannot look up is refused when it is written
     if (!overwrite && std::filesystem::exists(path, ec))
         throw Error(path + ": file exists (pass --overwrite to replace it)");
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
+        throw Error(path + ": no folder " + folder.string() + " to write it in");
+}
+
+// A path as the file it names: links and dots resolved where the system can, else as written.
+static std::filesystem::path file_named(const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+    return ec ? std::filesystem::absolute(path, ec).lexically_normal() : p;
+}
+
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+    for (std::size_t i = 0; i < outputs.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j) {
+            const auto& [a_option, a] = outputs[j];
+            const auto& [b_option, b] = outputs[i];
+            if (!a.empty() && !b.empty() && file_named(a) == file_named(b))
+                throw Error(b_option + " " + b + " names the same file as " + a_option + " " + a);
+        }
 }
 
 void check_threads(unsigned threads) {

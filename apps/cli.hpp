@@ -43,22 +43,33 @@ struct AccelOptions {
     std::string device = "cpu";
     std::vector<std::string> params;
     unsigned threads = 0;
-    CLI::Option* simd_option = nullptr;
+    CLI::Option *simd_option = nullptr, *traversal_option = nullptr, *params_option = nullptr,
+                *threads_option = nullptr;
 
     void add_to(CLI::App& cmd, bool kind_optional, bool with_device = false);
     AccelConfig config() const;
+    // Whether --traversal, --simd, -P or --threads was given: they describe a structure.
+    bool describes_structure() const;
+    // The option the SIMD set came from, as the user typed it: --simd, or --accel 'kd+sse'.
+    std::string simd_source() const;
 };
 
 // The structure for `config`, as make_accelerator builds it. Where it is refused and the library
-// refuses the SIMD set too, the error is the --simd option's: the library speaks of the set, the user
-// typed the option (looked at only after a refusal: Embree ignores the set, and a bad one is no error
-// for it).
-std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config);
+// refuses the SIMD set too, the error is the option's that named the set (`simd_source`): the library
+// speaks of the set, the user typed the option (looked at only after a refusal: Embree ignores the set,
+// and a bad one is no error for it).
+std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
+                                             const std::string& simd_source = "--simd");
 
 void print_stats(const AccelStats& s);
 
-// Refuses at the start, before any work, to replace a file the user has (unless `overwrite`).
+// Refuses at the start, before any work, to replace a file the user has (unless `overwrite`), or to
+// write into a folder that is not there.
 void check_output(const std::string& path, bool overwrite);
+// Refuses two outputs (option, path) that name one file: the second would replace the first.
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+// A CLI11 check that refuses an empty value (an option given as "" means no default).
+CLI::Validator non_empty();
 
 // Refuses a --threads of more than the library's kMaxWorkers.
 void check_threads(unsigned threads);

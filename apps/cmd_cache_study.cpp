@@ -326,8 +326,10 @@ Runner add_cache_study(CLI::App& app) {
                                                   "local-store model, or the GPU's shared-memory caches: CSV for "
                                                   "bench/plot_cache_study.py");
     cmd->add_option("scenes", o->scenes, scene_help() + "; one or more")->required();
-    cmd->add_option("-o,--out", o->out, "Output folder (cache_study.csv, best_layouts.md)")->capture_default_str();
-    cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default: each view file's)");
+    cmd->add_option("-o,--out", o->out, "Output folder (cache_study.csv, best_layouts.md)")
+        ->capture_default_str()
+        ->check(non_empty());
+    cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default: each view file's)")->check(non_empty());
     cmd->add_option("--packet", o->packet, "Packet edge P: P x P primary rays, then their shadow rays")
         ->capture_default_str();
     cmd->add_option("--sample", o->sample, "Trace the packets whose column + row is a multiple of N (1: all)")

@@ -73,10 +73,13 @@ Runner add_info(CLI::App& app) {
             if (o->accel.device == "cuda") return 0;
             throw Error("info: give a scene, --params KIND or --device cuda");
         }
+        if (o->accel.kind.empty() && o->accel.describes_structure())
+            throw Error("info: --traversal, --simd, -P and --threads describe a structure: give --accel too");
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         print_scene(scene, load_timer.seconds());
-        if (!o->accel.kind.empty()) print_stats(build_structure(scene.triangles, o->accel.config())->stats());
+        if (!o->accel.kind.empty())
+            print_stats(build_structure(scene.triangles, o->accel.config(), o->accel.simd_source())->stats());
         return 0;
     };
 }

@@ -272,10 +272,12 @@ int run_profile(const ProfileOptions& o) {
     Profile p;
     p.hardware = use_hardware_counters(o.method);
     if (!o.json.empty()) check_output(o.json, o.overwrite);
+    if (o.packet < 1 || o.packet > kMaxPacket)
+        throw Error("--packet " + std::to_string(o.packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
     p.config = profiled_config(o.accel, p.hardware);
     const Scene scene = load_scene(o.scene);
     p.frame = profiled_frame(scene, o, p.hardware);
-    const auto accel = build_structure(scene.triangles, p.config);
+    const auto accel = build_structure(scene.triangles, p.config, o.accel.simd_source());
     p.structure = accel->stats();
     print_setup(scene, p.structure, p.config, p.frame, p.hardware, o.size.empty());
 
@@ -302,14 +304,15 @@ Runner add_profile(CLI::App& app) {
                                               "(docs/PROFILE.md)");
     cmd->add_option("scene", o->scene, scene_help())->required();
     o->accel.add_to(*cmd, false);
-    cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's; 128x128 under callgrind)");
+    cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's; 128x128 under callgrind)")
+        ->check(non_empty());
     cmd->add_option("--packet", o->packet, "Packet edge P: the renderer traces P x P rays at a time")
         ->capture_default_str();
     cmd->add_option("--method", o->method, "Where counts come from: hardware (perf_event_open), callgrind, or auto "
                                            "(hardware where available)")
         ->check(CLI::IsMember({"auto", "hardware", "callgrind"}))
         ->capture_default_str();
-    cmd->add_option("--json", o->json, "Also write the figures as JSON to this file");
+    cmd->add_option("--json", o->json, "Also write the figures as JSON to this file")->check(non_empty());
     cmd->add_flag("--overwrite", o->overwrite, "Replace the JSON file if it exists");
     cmd->add_option("--callgrind-child", o->child, "Internal: render for callgrind to measure this region")
         ->check(CLI::IsMember({"render", "traversal"}))

@@ -168,8 +168,10 @@ Runner add_render(CLI::App& app) {
     auto* cmd = app.add_subcommand("render", "Render a scene to an image (primary rays and those their shading casts)");
     cmd->add_option("scene", o->scene, scene_help())->capture_default_str();
     o->accel.add_to(*cmd, false, true);
-    cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's)");
-    cmd->add_option("-o,--output", o->out, "Output image: .png (sRGB) or .pfm (exact floats)")->capture_default_str();
+    cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's)")->check(non_empty());
+    cmd->add_option("-o,--output", o->out, "Output image: .png (sRGB) or .pfm (exact floats)")
+        ->capture_default_str()
+        ->check(non_empty());
     cmd->add_flag("--overwrite", o->overwrite, "Replace the output file if it exists");
     cmd->add_option("--shading", o->shading,
                     "direct: one shadow ray per hit (the study's); ao: ambient occlusion; diffuse: one bounce lit "
@@ -185,7 +187,8 @@ Runner add_render(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("--pin", o->pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     o->local_store.add_to(*cmd);
-    cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE");
+    cmd->add_option("--stats", o->stats, "Write the run's figures (each worker's load, the local store's) as JSON to FILE")
+        ->check(non_empty());
     cluster::add_render_options(*cmd);
     return [o, ao_samples] {
         // Under MPI each step runs on every rank, and a step that fails on one fails on all
@@ -203,6 +206,7 @@ Runner add_render(CLI::App& app) {
             if (cluster::leader()) {
                 check_output(o->out, o->overwrite);
                 if (!o->stats.empty()) check_output(o->stats, o->overwrite);
+                check_distinct_outputs({{"-o", o->out}, {"--stats", o->stats}});
             }
         }, "checking the options");
         Timer load_timer;
@@ -234,7 +238,7 @@ Runner add_render(CLI::App& app) {
                 if (o->accel.simd_option->count() == 0) config.simd = "off";
                 modelled = make_local_store_accelerator(scene.triangles, config, local_store);
             } else {
-                direct = build_structure(scene.triangles, o->accel.config());
+                direct = build_structure(scene.triangles, o->accel.config(), o->accel.simd_source());
             }
         }, "building the structure");
         const Accelerator& accel = modelled ? *modelled : *direct;

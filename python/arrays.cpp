@@ -129,8 +129,8 @@ std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
             const std::int64_t k = index[3 * t + c];
             if (k < 0 || static_cast<std::uint64_t>(k) >= v.rows)
                 throw py::value_error("faces[" + std::to_string(t) + ", " + std::to_string(c) + "] = " +
-                                      std::to_string(k) + " is out of range for " + std::to_string(v.rows) +
-                                      " vertices");
+                                      (kind == 'u' ? std::to_string(static_cast<std::uint64_t>(k)) : std::to_string(k)) +
+                                      " is out of range for " + std::to_string(v.rows) + " vertices");
             const float* p = v.data + 3 * k;
             corner[c] = Vec3{p[0], p[1], p[2]};
         }

@@ -182,6 +182,7 @@ std::shared_ptr<Scene> load(py::handle path) {
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
     }
     const std::string spec = text(p, "path");
+    if (spec.find('\0') != std::string::npos) throw py::value_error("path must not contain a NUL character");
     py::gil_scoped_release unlocked;
     return std::make_shared<Scene>(load_scene(spec));
 }

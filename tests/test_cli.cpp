@@ -158,6 +158,9 @@ TEST(Cli, RefusesBadOptions) {
              {"render", "--shading", "ao", "--ao-samples", "0", "-o", out},
              {"render", "--ao-samples", "4", "-o", out},
              {"render", "-o", (dir.path / "no" / "such" / "x.png").string()},
+             {"render", "--size", "", "-o", out},
+             {"render", "--traversal", "", "-o", out},
+             {"render", "--stats", "", "-o", out},
          }) {
         EXPECT_NE(run(args), 0) << args[1] << " " << args[2];
         EXPECT_FALSE(fs::exists(out));
@@ -224,6 +227,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     std::ofstream(huge_index) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 99999999999999999999\n";
     const std::string long_name = (dir.path / (std::string(300, 'a') + ".obj")).string();
     const std::string spheres = "builtin:spheres?tris=100";
+    const std::string folder_obj = (dir.path / "folder.obj").string();
+    fs::create_directory(folder_obj);
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
         {{"info", over}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
         {{"render", over, "-o", out}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
@@ -253,6 +258,21 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "--accel", "auto@packets=bvh,bvh_packets=off"},
          "auto: bvh_packets=off contradicts packets=bvh, whose packets are the BVH's own (leave bvh_packets out, or "
          "choose another tree for the packets)"},
+        {{"render", spheres, "--accel", "auto@packets=kd,packets=bvh", "-o", out},
+         "--accel 'auto@packets=kd,packets=bvh': accelerator parameter 'packets' is given twice"},
+        {{"info", spheres, "--accel", "kd:"}, "--accel 'kd:': no traversal after ':'"},
+        {{"info", spheres, "--accel", "kd+"}, "--accel 'kd+': no SIMD instruction set after '+'"},
+        {{"render", spheres, "--accel", "kd", "-P", "leaf_size=3", "-P", "leaf_size=4", "-o", out},
+         "--param 'leaf_size=4' contradicts --param 'leaf_size=3'"},
+        {{"info", spheres, "--accel", "kd+avx9"},
+         "--accel 'kd+avx9': SIMD instruction set 'avx9' is not one of: auto, off, portable, sse, avx2, avx512"},
+        {{"info", spheres, "-P", "bogus"}, "info: --traversal, --simd, -P and --threads describe a structure: give "
+                                           "--accel too"},
+        {{"info", "builtin:city?tris=100&tris=200"}, "builtin:city?tris=100&tris=200: 'tris' is given twice"},
+        {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
+        {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
+        {{"render", spheres, "-o", out, "--stats", (dir.path / "no" / "s.json").string()},
+         (dir.path / "no" / "s.json").string() + ": no folder " + (dir.path / "no").string() + " to write it in"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);

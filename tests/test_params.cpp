@@ -189,7 +189,7 @@ TEST(Params, AcceleratorSpecsSplitOrAreRefused) {
 }
 
 // A configuration written back is the canonical spec that parses to it: parts left out when absent
-// or "off", parameters by name, the last of a repeated name kept (as the parse keeps it).
+// or "off", parameters by name. A repeated name, and an empty traversal or SIMD set, are refused.
 TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
     for (const auto& [spec, canonical] : std::vector<std::pair<std::string, std::string>>{
              {"kd", "kd"},
@@ -198,7 +198,6 @@ TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
              {"bih+avx2", "bih+avx2"},
              {"kd:rec+avx2@leaf_size=2,bins=64", "kd:rec+avx2@bins=64,leaf_size=2"},
              {"auto@packets=bvh", "auto@packets=bvh"},
-             {"bvh@bins=8,bins=16", "bvh@bins=16"},
              {"kd@note=a:b+c", "kd@note=a:b+c"}}) {
         const AccelConfig c = parse_accel_config(spec);
         EXPECT_EQ(format_accel_config(c), canonical) << spec;
@@ -208,6 +207,8 @@ TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
         EXPECT_EQ(back.simd, c.simd) << spec;
         EXPECT_EQ(back.params, c.params) << spec;
     }
+    for (const char* bad : {"bvh@bins=8,bins=16", "kd:", "kd+", "kd:+sse"})
+        EXPECT_THROW(parse_accel_config(bad), Error) << bad;
     EXPECT_EQ(format_accel_config(default_accel_config()), "auto@packets=bvh");
     EXPECT_EQ(format_accel_config(default_accel_config("cuda")), "kd");
 }

@@ -33,7 +33,8 @@ std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Trian
 
 // An accelerator configuration written as one string, as the benchmarks and tests name them:
 // KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd:rec", "bih+avx2", "kd+auto@leaf_size=2,bins=64".
-// Throws cellrt::Error for a malformed parameter; the parts themselves are checked by make_accelerator.
+// Throws cellrt::Error for a malformed or repeated parameter and for an empty traversal or SIMD set after
+// ':' or '+'; the parts themselves are checked by make_accelerator.
 AccelConfig parse_accel_config(std::string spec);
 
 // The configuration written as parse_accel_config reads it, in one canonical form: the traversal when

@@ -157,17 +157,22 @@ AccelConfig parse_accel_config(std::string spec) {
             const auto eq = kv.find('=');
             if (eq == std::string::npos || eq == 0)
                 throw Error("accelerator parameter '" + kv + "' must have the form NAME=VALUE");
-            c.params[kv.substr(0, eq)] = kv.substr(eq + 1);
+            if (!c.params.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
+                throw Error("accelerator parameter '" + kv.substr(0, eq) + "' is given twice");
             b = e + 1;
         }
     }
     if (const auto plus = spec.find('+'); plus != std::string::npos) {
         c.simd = spec.substr(plus + 1);
         spec.resize(plus);
+        if (c.simd.empty()) throw Error("no SIMD instruction set after '+'");
     }
     const auto colon = spec.find(':');
     c.kind = spec.substr(0, colon);
-    if (colon != std::string::npos) c.traversal = spec.substr(colon + 1);
+    if (colon != std::string::npos) {
+        c.traversal = spec.substr(colon + 1);
+        if (c.traversal.empty()) throw Error("no traversal after ':'");
+    }
     return c;
 }
 

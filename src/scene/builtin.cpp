@@ -3,6 +3,7 @@
 #include <charconv>
 #include <limits>
 #include <string_view>
+#include <utility>
 
 #include "builtin_generators.hpp"
 #include "cellrt/error.hpp"
@@ -68,6 +69,7 @@ Scene make_builtin_scene(const std::string& spec) {
     BuiltinParams params;
     params.tris = gen->default_tris;
     std::string_view query = q == std::string_view::npos ? std::string_view{} : rest.substr(q + 1);
+    bool tris_given = false, seed_given = false;
     while (!query.empty()) {
         const std::size_t amp = query.find('&');
         const std::string_view pair = query.substr(0, amp);
@@ -75,6 +77,8 @@ Scene make_builtin_scene(const std::string& spec) {
         const std::size_t eq = pair.find('=');
         if (eq == std::string_view::npos) throw Error(spec + ": expected key=value, got '" + std::string(pair) + "'");
         const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
+        if ((key == "tris" && std::exchange(tris_given, true)) || (key == "seed" && std::exchange(seed_given, true)))
+            throw Error(spec + ": '" + std::string(key) + "' is given twice");
         if (key == "tris") {
             params.tris = parse_unsigned(value, spec, key, 100, 100'000'000);
         } else if (key == "seed") {

@@ -11,6 +11,8 @@
 namespace cellrt::detail {
 
 inline std::string read_file(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open file for reading");
     std::ostringstream ss;

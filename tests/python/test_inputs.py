@@ -58,6 +58,7 @@ V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
 @pytest.mark.parametrize("vertices,faces,match", [
     (V, [[0, 1, 3]], r"faces\[0, 2\] = 3 is out of range for 3 vertices"),
     (V, [[0, 1, 2], [0, -1, 2]], r"faces\[1, 1\] = -1 is out of range for 3 vertices"),
+    (V, np.array([[0, 1, 2**64 - 1]], np.uint64), r"faces\[0, 2\] = 18446744073709551615 is out of range"),
     (V, np.array([[0, 1, 2]], np.float32), "faces must hold integers, got dtype float32"),
     (V, np.array([[0, 1, 2]], bool), "faces must hold integers, got dtype bool"),
     (V, [[0, 1]], r"faces must have shape \(M, 3\), got \(1, 2\)"),
@@ -141,6 +142,7 @@ def test_bad_scene_files(tmp_path):
         cellrt.load_scene("builtin:nothing")
     refused("path must be a str or os.PathLike, got 3", cellrt.load_scene, 3)
     refused("path must be a str", cellrt.load_scene, b"x.obj")
+    refused("path must not contain a NUL character", cellrt.load_scene, "a\x00b.obj")
 
 
 def test_bad_render_arguments(tmp_path):
