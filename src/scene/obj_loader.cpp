@@ -73,6 +73,22 @@ private:
         std::size_t vertices_before;
     };
 
+    // Whether a corner's texture and normal indices, after its vertex's ("/vt", "//vn", "/vt/vn"), are
+    // integers where present: unused here, but a corner holding anything else is malformed.
+    static bool valid_attributes(std::string_view after) {
+        for (int part = 0; !after.empty(); ++part) {
+            if (part == 2 || after.front() != '/') return false;
+            after.remove_prefix(1);
+            const std::string_view number = after.substr(0, after.find('/'));
+            std::int64_t unused = 0;
+            const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), unused);
+            if (!number.empty() && (ptr != number.data() + number.size() || ec == std::errc::invalid_argument))
+                return false;
+            after.remove_prefix(number.size());
+        }
+        return true;
+    }
+
     void parse_face(std::string_view rest) {
         const std::size_t first = corners_.size();
         for (std::string_view tok = next_token(rest); !tok.empty(); tok = next_token(rest)) {
@@ -80,7 +96,7 @@ private:
             std::int64_t index = 0;
             const auto [ptr, ec] = std::from_chars(pos.data(), pos.data() + pos.size(), index);
             if (ptr != pos.data() + pos.size() || pos.empty() ||
-                (ec != std::errc() && ec != std::errc::result_out_of_range))
+                (ec != std::errc() && ec != std::errc::result_out_of_range) || !valid_attributes(tok.substr(pos.size())))
                 fail("malformed face index '" + std::string(tok) + "'", line_);
             if (ec == std::errc::result_out_of_range)  // beyond 64 bits: no file has that many vertices
                 fail("face index " + std::string(pos) + " is out of range", line_);
