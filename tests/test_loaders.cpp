@@ -599,6 +599,28 @@ TEST_F(LoaderTest, ViewFileNumbersBeyondTheirRangeAreNamed) {
     }
 }
 
+// A field the format does not have is named, with the fields known there: a misspelt optional one
+// would otherwise leave its default in place.
+TEST_F(LoaderTest, ViewFileFieldsTheFormatLacksAreNamed) {
+    write("tri.obj", kTriangleObj);
+    struct Case {
+        const char* object;  // "" for the top level
+        const char* key;
+        std::string message;
+    };
+    for (const Case& c : std::vector<Case>{
+             {"", "bogus", "field 'bogus' is not part of a view file (known here: name, mesh, camera, light, image)"},
+             {"camera", "fov_x", "field 'camera.fov_x' is not part of a view file (known here: position, look_at, up, "
+                                 "fov_y_deg)"},
+             {"light", "colour", "field 'light.colour' is not part of a view file (known here: type, position, color)"},
+             {"image", "depth", "field 'image.depth' is not part of a view file (known here: width, height)"}}) {
+        json doc = view_doc();
+        (std::string(c.object).empty() ? doc : doc[c.object])[c.key] = 1;
+        const std::string path = write("view.json", doc.dump());
+        EXPECT_EQ(error_of([&] { load_view_file(path); }), path + ": " + c.message) << c.key;
+    }
+}
+
 // An image too large to allocate is refused, though each side alone is allowed.
 TEST_F(LoaderTest, ViewFileImageOfTooManyPixelsIsRefused) {
     write("tri.obj", kTriangleObj);

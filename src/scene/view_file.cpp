@@ -89,6 +89,18 @@ public:
                 static_cast<float>(number(j[2], name + "[2]"))};
     }
 
+    // Refuses a key the format does not have: a misspelt optional field ("colour") would otherwise
+    // leave its default in place without a word.
+    void only(const json& object, const std::string& object_name, std::initializer_list<const char*> keys) const {
+        if (!object.is_object()) return;  // field() says what is wrong with it
+        for (const auto& [key, value] : object.items()) {
+            if (std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) continue;
+            std::string known;
+            for (const char* k : keys) known += (known.empty() ? "" : ", ") + std::string(k);
+            fail(object_name.empty() ? key : object_name + "." + key, "is not part of a view file (known here: " + known + ")");
+        }
+    }
+
     int positive_int(const json& parent, const std::string& parent_name, const char* key) const {
         const std::string name = parent_name + "." + key;
         const json& j = field(parent, parent_name, key);
@@ -108,6 +120,7 @@ public:
             throw Error(path_ + ":" + std::to_string(line) + ": invalid JSON: " + reason(e));
         }
         if (!doc.is_object()) throw Error(path_ + ": a view file must be a JSON object");
+        only(doc, "", {"name", "mesh", "camera", "light", "image"});
 
         const json& mesh = field(doc, "", "mesh");
         if (!mesh.is_string() || mesh.get<std::string>().empty()) fail("mesh", "must be a non-empty string");
@@ -121,17 +134,20 @@ public:
                          ? doc["name"].get<std::string>()
                          : std::filesystem::path(path_).stem().string();
         const json& cam = field(doc, "", "camera");
+        only(cam, "camera", {"position", "look_at", "up", "fov_y_deg"});
         scene.camera.position = vec3(cam, "camera", "position");
         scene.camera.look_at = vec3(cam, "camera", "look_at");
         scene.camera.up = vec3(cam, "camera", "up");
         scene.camera.fov_y_deg = static_cast<float>(number(field(cam, "camera", "fov_y_deg"), "camera.fov_y_deg"));
 
         const json& light = field(doc, "", "light");
+        only(light, "light", {"type", "position", "color"});
         if (light.contains("type") && light["type"] != "point") fail("light.type", "must be \"point\"");
         scene.light.position = vec3(light, "light", "position");
         if (light.contains("color")) scene.light.color = vec3(light, "light", "color");
 
         const json& image = field(doc, "", "image");
+        only(image, "image", {"width", "height"});
         scene.width = positive_int(image, "image", "width");
         scene.height = positive_int(image, "image", "height");
 
