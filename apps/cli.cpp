@@ -70,6 +70,12 @@ AccelConfig AccelOptions::config() const {
     } else {
         c.simd = (!c.traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
     }
+    // A kd-tree's or BIH's traversals are single-ray kernels, which SIMD packets replace: asked for
+    // together, one would be dropped without a word (the BVH's traversals take an instruction set).
+    if ((c.kind == "kd" || c.kind == "bih") && !c.traversal.empty() && c.simd != "off")
+        throw Error((traversal.empty() ? "--accel '" + kind + "'" : "--traversal '" + traversal + "'") +
+                    " names a single-ray kernel, which the SIMD packets of " + simd_source() +
+                    " replace: leave one of them out");
     c.device = device;
     c.threads = threads;
     const AccelConfig named = c;  // what --accel set

@@ -269,6 +269,12 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "-P", "bogus"}, "info: --traversal, --simd, -P and --threads describe a structure: give "
                                            "--accel too"},
         {{"info", "builtin:city?tris=100&tris=200"}, "builtin:city?tris=100&tris=200: 'tris' is given twice"},
+        {{"info", spheres, "--accel", "kd", "--traversal", "rec", "--simd", "sse"},
+         "--traversal 'rec' names a single-ray kernel, which the SIMD packets of --simd replace: leave one of them "
+         "out"},
+        {{"info", spheres, "--accel", "bih:branched+auto"},
+         "--accel 'bih:branched+auto' names a single-ray kernel, which the SIMD packets of --accel "
+         "'bih:branched+auto' replace: leave one of them out"},
         {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
         {{"render", spheres, "-o", out, "--stats", (dir.path / "no" / "s.json").string()},
