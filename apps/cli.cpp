@@ -70,12 +70,6 @@ AccelConfig AccelOptions::config() const {
     } else {
         c.simd = (!c.traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
     }
-    // A kd-tree's or BIH's traversals are single-ray kernels, which SIMD packets replace: asked for
-    // together, one would be dropped without a word (the BVH's traversals take an instruction set).
-    if ((c.kind == "kd" || c.kind == "bih") && !c.traversal.empty() && c.simd != "off")
-        throw Error((traversal.empty() ? "--accel '" + kind + "'" : "--traversal '" + traversal + "'") +
-                    " names a single-ray kernel, which the SIMD packets of " + simd_source() +
-                    " replace: leave one of them out");
     c.device = device;
     c.threads = threads;
     const AccelConfig named = c;  // what --accel set
@@ -109,18 +103,26 @@ CLI::Validator non_empty() {
 }
 
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
-                                             const std::string& simd_source) {
+                                             const AccelOptions& options) {
+    std::unique_ptr<Accelerator> accel;
     try {
-        return make_accelerator(triangles, config);
+        accel = make_accelerator(triangles, config);
     } catch (const Error&) {
         if (config.simd == "off") throw;
         try {
             detail::parse_isa(config.simd);
         } catch (const Error& e) {
-            throw Error(simd_source + ": " + e.what());
+            throw Error(options.simd_source() + ": " + e.what());
         }
         throw;
     }
+    // A structure whose traversals are single-ray kernels runs its SIMD packets instead: asked for
+    // together, the traversal would be dropped without a word (the BVH's take an instruction set).
+    if (!config.traversal.empty() && accel->stats().traversal != config.traversal)
+        throw Error((options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'") +
+                    " names a single-ray kernel, which the SIMD packets of " + options.simd_source() +
+                    " replace: leave one of them out");
+    return accel;
 }
 
 void check_output(const std::string& path, bool overwrite) {

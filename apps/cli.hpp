@@ -54,12 +54,13 @@ struct AccelOptions {
     std::string simd_source() const;
 };
 
-// The structure for `config`, as make_accelerator builds it. Where it is refused and the library
-// refuses the SIMD set too, the error is the option's that named the set (`simd_source`): the library
-// speaks of the set, the user typed the option (looked at only after a refusal: Embree ignores the set,
-// and a bad one is no error for it).
+// The structure for `config` (made from `options`), as make_accelerator builds it. Where it is refused
+// and the library refuses the SIMD set too, the error is the option's that named the set: the library
+// speaks of the set, the user typed the option (looked at only after a refusal: Embree ignores the
+// set, and a bad one is no error for it). A traversal the structure does not run (a kd-tree's, with
+// SIMD packets) is refused.
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
-                                             const std::string& simd_source = "--simd");
+                                             const AccelOptions& options);
 
 void print_stats(const AccelStats& s);
 

@@ -79,7 +79,7 @@ Runner add_info(CLI::App& app) {
         const Scene scene = load_scene(o->scene);
         print_scene(scene, load_timer.seconds());
         if (!o->accel.kind.empty())
-            print_stats(build_structure(scene.triangles, o->accel.config(), o->accel.simd_source())->stats());
+            print_stats(build_structure(scene.triangles, o->accel.config(), o->accel)->stats());
         return 0;
     };
 }

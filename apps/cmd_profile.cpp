@@ -277,7 +277,7 @@ int run_profile(const ProfileOptions& o) {
     p.config = profiled_config(o.accel, p.hardware);
     const Scene scene = load_scene(o.scene);
     p.frame = profiled_frame(scene, o, p.hardware);
-    const auto accel = build_structure(scene.triangles, p.config, o.accel.simd_source());
+    const auto accel = build_structure(scene.triangles, p.config, o.accel);
     p.structure = accel->stats();
     print_setup(scene, p.structure, p.config, p.frame, p.hardware, o.size.empty());
 

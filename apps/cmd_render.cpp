@@ -238,7 +238,7 @@ Runner add_render(CLI::App& app) {
                 if (o->accel.simd_option->count() == 0) config.simd = "off";
                 modelled = make_local_store_accelerator(scene.triangles, config, local_store);
             } else {
-                direct = build_structure(scene.triangles, o->accel.config(), o->accel.simd_source());
+                direct = build_structure(scene.triangles, o->accel.config(), o->accel);
             }
         }, "building the structure");
         const Accelerator& accel = modelled ? *modelled : *direct;
