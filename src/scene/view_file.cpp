@@ -93,7 +93,8 @@ public:
     // leave its default in place without a word.
     void only(const json& object, const std::string& object_name, std::initializer_list<const char*> keys) const {
         if (!object.is_object()) return;  // field() says what is wrong with it
-        for (const auto& [key, value] : object.items()) {
+        for (const auto& item : object.items()) {
+            const std::string& key = item.key();
             if (std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) continue;
             std::string known;
             for (const char* k : keys) known += (known.empty() ? "" : ", ") + std::string(k);
