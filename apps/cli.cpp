@@ -64,8 +64,7 @@ AccelConfig AccelOptions::config() const {
         c.traversal = traversal;
     }
     const bool simd_given = simd_option && simd_option->count() > 0;
-    const bool simd_named = kind.substr(0, kind.find('@')).find('+') != std::string::npos;
-    if (simd_named) {
+    if (simd_named()) {
         if (simd_given && simd != c.simd) throw contradiction("--simd '" + simd + "'");
     } else {
         c.simd = (!c.traversal.empty() || device != "cpu") && !simd_given ? "off" : simd;
@@ -92,10 +91,9 @@ bool AccelOptions::describes_structure() const {
     return false;
 }
 
-std::string AccelOptions::simd_source() const {
-    const bool simd_named = kind.substr(0, kind.find('@')).find('+') != std::string::npos;
-    return simd_named ? "--accel '" + kind + "'" : "--simd";
-}
+bool AccelOptions::simd_named() const { return kind.substr(0, kind.find('@')).find('+') != std::string::npos; }
+
+std::string AccelOptions::simd_source() const { return simd_named() ? "--accel '" + kind + "'" : "--simd"; }
 
 CLI::Validator non_empty() {
     return CLI::Validator([](const std::string& s) { return s.empty() ? std::string("must not be empty") : std::string(); },

@@ -50,6 +50,8 @@ struct AccelOptions {
     AccelConfig config() const;
     // Whether --traversal, --simd, -P or --threads was given: they describe a structure.
     bool describes_structure() const;
+    // Whether --accel's string names a SIMD set ("kd+sse").
+    bool simd_named() const;
     // The option the SIMD set came from, as the user typed it: --simd, or --accel 'kd+sse'.
     std::string simd_source() const;
 };

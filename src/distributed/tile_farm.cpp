@@ -8,7 +8,6 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
-#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <memory>
@@ -19,6 +18,7 @@
 #include <variant>
 
 #include "core/timer.hpp"
+#include "distributed/faults.hpp"
 #include "distributed/tile_window.hpp"
 
 namespace cellrt::distributed {
@@ -143,16 +143,11 @@ void add_tile(RankLoad& load, const RenderStats& s, std::size_t packets) {
     }
 }
 
-// The test suite's way to make a rank die or stop answering once it holds a tile (tests/mpi/,
-// docs/DISTRIBUTED.md): CELLRT_MPI_FAULT=kill:R or stall:R.
+// The test suite's way to make a rank die or stop answering once it holds a tile (faults.hpp):
+// CELLRT_MPI_FAULT=kill:R or stall:R.
 void inject_fault(int rank) {
-    const char* fault = std::getenv("CELLRT_MPI_FAULT");
-    if (!fault) return;
-    const std::string f = fault;
-    const auto colon = f.find(':');
-    if (colon == std::string::npos || std::atoi(f.c_str() + colon + 1) != rank) return;
-    if (f.compare(0, colon, "kill") == 0) std::raise(SIGKILL);
-    if (f.compare(0, colon, "stall") == 0)
+    if (fault_named("kill", rank)) std::raise(SIGKILL);
+    if (fault_named("stall", rank))
         for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
 }
 

@@ -10,10 +10,11 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <numeric>
 #include <string>
+
+#include "distributed/faults.hpp"
 
 namespace cellrt::distributed {
 namespace {
@@ -24,17 +25,6 @@ constexpr std::size_t kNameBytes = 64;
 // Beyond it (huge tiles held far ahead by many ranks) the pixels travel as messages.
 constexpr std::size_t kMostShared = std::size_t{1} << 30;
 
-// The test suite's ways to deny a rank the shared memory, or to seat it on a machine of its own
-// (tests/test_distributed.cpp): CELLRT_MPI_FAULT=noshm:R or apart:R.
-bool fault(const char* kind, int rank) {
-    const char* f = std::getenv("CELLRT_MPI_FAULT");
-    const std::size_t n = std::strlen(kind);
-    return f && std::strncmp(f, kind, n) == 0 && f[n] == ':' && std::atoi(f + n + 1) == rank;
-}
-bool any_fault(const char* kind) {
-    const char* f = std::getenv("CELLRT_MPI_FAULT");
-    return f && std::strncmp(f, kind, std::strlen(kind)) == 0;
-}
 
 // Rank 0: makes the shared object `name` of `bytes` and maps it; null with `why` set when it cannot.
 char* make_shared(const char* name, std::size_t bytes, std::string& why) {
@@ -76,9 +66,11 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
     // The ranks of each machine, in world order: the first of rank 0's machine is rank 0.
     MPI_Comm machine = MPI_COMM_NULL;
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, session.rank(), MPI_INFO_NULL, &machine);
-    if (any_fault("apart")) {
+    // The test suite's faults (faults.hpp): apart:R seats rank R on a machine of its own, noshm:R denies
+    // it the shared memory.
+    if (fault_named("apart")) {
         MPI_Comm apart = MPI_COMM_NULL;
-        MPI_Comm_split(machine, fault("apart", session.rank()) ? 1 : 0, session.rank(), &apart);
+        MPI_Comm_split(machine, fault_named("apart", session.rank()) ? 1 : 0, session.rank(), &apart);
         MPI_Comm_free(&machine);
         machine = apart;
     }
@@ -100,12 +92,12 @@ TileWindow::TileWindow(const Session& session, bool wanted, std::size_t bytes_ea
     char* base = nullptr;
     if (session.leader() && fits) {
         std::snprintf(name, sizeof name, "/cellrt-tiles-%ld-%u", static_cast<long>(getpid()), frames++);
-        base = fault("noshm", 0) ? nullptr : make_shared(name, bytes, why);
-        if (fault("noshm", 0)) why = "denied by CELLRT_MPI_FAULT";
+        base = fault_named("noshm", 0) ? nullptr : make_shared(name, bytes, why);
+        if (fault_named("noshm", 0)) why = "denied by CELLRT_MPI_FAULT";
         if (!base) name[0] = '\0';
     }
     MPI_Bcast(name, static_cast<int>(sizeof name), MPI_CHAR, 0, machine);
-    if (name[0] != '\0' && !session.leader() && !fault("noshm", session.rank())) base = map_shared(name, bytes);
+    if (name[0] != '\0' && !session.leader() && !fault_named("noshm", session.rank())) base = map_shared(name, bytes);
     int mapped = base != nullptr, all_mapped = 0;
     MPI_Allreduce(&mapped, &all_mapped, 1, MPI_INT, MPI_MIN, machine);
     if (session.leader() && name[0] != '\0') shm_unlink(name);  // every rank has it mapped, or has given up
