@@ -16,6 +16,8 @@
 #include <iterator>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "cellrt/image.hpp"
 
 extern char** environ;
@@ -323,6 +325,20 @@ TEST(Cli, StatsOfAFileNamedInAnyBytes) {
     std::ifstream in(stats);
     const std::string json{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     EXPECT_NE(json.find("\"scene\": \"\xef\xbf\xbd\xef\xbf\xbd\""), std::string::npos) << json.substr(0, 200);
+}
+
+// The stats' two spans of a frame: the tracing (render_seconds) within the frame from its memory to
+// its last pixel (frame_seconds), the span cellrt-mpi's frames are compared on.
+TEST(Cli, StatsGiveTheTracingWithinTheFrame) {
+    TempDir dir;
+    const std::string stats = (dir.path / "stats.json").string();
+    const auto [text, status] = run_for_error({"render", "builtin:spheres?tris=500", "--size", "64x48", "-o",
+                                               (dir.path / "x.pfm").string(), "--stats", stats}, dir.path);
+    ASSERT_EQ(status, 0) << text;
+    const nlohmann::json j = nlohmann::json::parse(std::ifstream(stats));
+    const double render = j.at("render_seconds").get<double>(), frame = j.at("frame_seconds").get<double>();
+    EXPECT_GT(render, 0.0);
+    EXPECT_GE(frame, render);
 }
 
 // --accel takes the configuration string the benchmarks, the C API and Python print: its traversal and

@@ -121,6 +121,7 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             const std::string report = read(stats);
             EXPECT_EQ(count(report, "\"tiles\""), static_cast<std::size_t>(ranks)) << report;
             EXPECT_NE(report.find("\"busy_seconds\""), std::string::npos);
+            EXPECT_NE(report.find("\"frame_seconds\""), std::string::npos) << report;
             EXPECT_NE(report.find("\"float\""), std::string::npos) << report;
             // Ranks on rank 0's machine (all here) write their pixels into its shared window.
             EXPECT_EQ(window_ranks(stats), ranks - 1) << report;

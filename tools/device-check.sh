@@ -142,9 +142,10 @@ run)
   fi
   # Runs of `cellrt render` and `cellrt-mpi render` of Sponza at 1080p (docs/DISTRIBUTED.md), five rounds
   # with the configurations in turn, each frame compared byte for byte with the first configuration's;
-  # each run's time is rank 0's render_seconds in its --stats file, without start-up, loading and
-  # building. Frames are written as .pfm (float pixels), or as .png with FRAME_EXT=png (cellrt-mpi's
-  # ranks then send 8-bit pixels). mpi_rounds INTO NAME=PROGRAM ARGS...
+  # each run's time is rank 0's frame_seconds in its --stats file (the frame from its memory to its
+  # last pixel, the same span in both programs), without start-up, loading and building. Frames
+  # are written as .pfm (float pixels), or as .png with FRAME_EXT=png (cellrt-mpi's ranks then send
+  # 8-bit pixels). mpi_rounds INTO NAME=PROGRAM ARGS...
   mpi_rounds() {
     local into="$1" first="${2%%=*}" ext="${FRAME_EXT:-pfm}" spec name args r
     shift
