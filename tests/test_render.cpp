@@ -6,7 +6,13 @@
 #include <limits>
 #include <filesystem>
 #include <fstream>
+#include <sys/mman.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
 
 #include "cellrt/accel.hpp"
 #include "cellrt/builtin.hpp"
@@ -14,6 +20,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
 #include "error_of.hpp"
+#include "sanitizers.hpp"
 
 namespace cellrt {
 namespace {
@@ -125,6 +132,51 @@ TEST(Render, PngOfEightBitPixelsIsThePngOfTheFloats) {
     EXPECT_EQ(test::error_of([&] { write_png(bytes, (dir / "x.pfm").string(), false); }),
               (dir / "x.pfm").string() + ": 8-bit pixels are written as .png only");
     std::filesystem::remove_all(dir);
+}
+
+// An image is zero when made (ZeroedArray); copies are deep; a moved-from array is empty.
+TEST(Render, ImagesAreZeroWhenMade) {
+    const Image small(3, 2);
+    ASSERT_EQ(small.pixels.size(), 6u);
+    using Bits = std::array<std::uint32_t, 3>;
+    for (const Vec3& p : small.pixels) EXPECT_EQ(std::bit_cast<Bits>(p), Bits{});  // +0, all bits zero
+    Image a(5, 4);
+    a.at(1, 2) = Vec3(1.f, 2.f, 3.f);
+    Image b = a;
+    EXPECT_TRUE(same_bits(a, b));
+    b.at(1, 2).x = 7.f;
+    EXPECT_EQ(a.at(1, 2).x, 1.f);
+    EXPECT_FALSE(a.pixels == b.pixels);
+    b = a;
+    EXPECT_TRUE(a.pixels == b.pixels);
+    const Image moved = std::move(b);
+    EXPECT_TRUE(b.pixels.empty());  // NOLINT(bugprone-use-after-move): the moved-from state is specified
+    EXPECT_TRUE(same_bits(moved, a));
+    const Srgb8Image bytes(4, 4);
+    EXPECT_TRUE(std::all_of(bytes.rgb.begin(), bytes.rgb.end(), [](std::uint8_t c) { return c == 0; }));
+    // A frame of 4 MiB or more has a mapping of its own (2 MiB pages), a copy too.
+    Image frame(1920, 1080);
+    frame.at(0, 0) = frame.at(1919, 1079) = Vec3(0.5f);
+    const Image copy = frame;
+    EXPECT_TRUE(same_bits(copy, frame));
+    EXPECT_EQ(copy.at(1919, 1079).y, 0.5f);
+    EXPECT_EQ(copy.at(1918, 1079).y, 0.f);
+}
+
+// ... and its memory untouched until written: a frame's pages are faulted in by the workers that
+// write them, not zeroed on one thread before the render. A 1080p frame's 25 MB: none of its pages
+// resident once made.
+TEST(Render, AFramesMemoryIsUntouchedWhenMade) {
+    CELLRT_SKIP_UNDER_SANITIZERS("the sanitizers' allocators write the memory they hand out");
+    const Image frame(1920, 1080);
+    const long page = ::sysconf(_SC_PAGESIZE);
+    const auto begin = reinterpret_cast<std::uintptr_t>(frame.pixels.data());
+    const std::uintptr_t first = (begin + page - 1) / page * page;
+    const std::uintptr_t end = (begin + frame.pixels.size() * sizeof(Vec3)) / page * page;
+    std::vector<unsigned char> resident((end - first) / page);
+    ASSERT_EQ(::mincore(reinterpret_cast<void*>(first), end - first, resident.data()), 0);
+    EXPECT_EQ(std::count_if(resident.begin(), resident.end(), [](unsigned char r) { return r & 1; }), 0);
+    EXPECT_EQ(frame.at(1919, 1079).z, 0.f);  // read as zero (the kernel's zero page)
 }
 
 // The table gives the formula's byte (every float of [0, 1] is checked by docs/figures/srgb8_check.cpp;

@@ -5,16 +5,16 @@
 #include <cstdint>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include "cellrt/vec.hpp"
+#include "cellrt/zeroed_array.hpp"
 
 namespace cellrt {
 
 struct Image {
     int width = 0;
     int height = 0;
-    std::vector<Vec3> pixels;  // row-major, row 0 at the top, linear radiance
+    ZeroedArray<Vec3> pixels;  // row-major, row 0 at the top, linear radiance; zero until written
 
     Image() = default;
     Image(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h) {}
@@ -33,7 +33,7 @@ void write_image(const Image& image, const std::string& path, bool overwrite);
 struct Srgb8Image {
     int width = 0;
     int height = 0;
-    std::vector<std::uint8_t> rgb;
+    ZeroedArray<std::uint8_t> rgb;
 
     Srgb8Image() = default;
     Srgb8Image(int w, int h) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3) {}

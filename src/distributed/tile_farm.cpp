@@ -387,8 +387,9 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
                       MPI_COMM_WORLD, &requests[r]);
     }
 
-    // The frame, made once the other ranks have their first tiles: zeroing 25 MB of 1080p floats
-    // takes some 5 ms, which they would otherwise wait out before starting.
+    // The frame, made once the other ranks have their first tiles. Its memory is not written when
+    // made (cellrt/zeroed_array.hpp): its pages are faulted in by the copies of the tiles, where
+    // zeroing 25 MB of 1080p floats took some 5 ms of rank 0's core first.
     if (pixels.srgb8) frame = Srgb8Image(grid.width, grid.height);
     else frame = Image(grid.width, grid.height);
 
