@@ -67,6 +67,9 @@ class PacketWorkload {
 public:
     PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
                    const ShadingOptions& shading = {});
+    // The same, for a frame already made by frame_shading(scene, camera, shading), which reads every
+    // triangle (the AO rays' reach): the workers of one frame share one.
+    PacketWorkload(const Scene& scene, const FrameShading& frame, std::size_t max_pixels);
     PacketWorkload(PacketWorkload&&) noexcept;
     PacketWorkload& operator=(PacketWorkload&&) noexcept;
     ~PacketWorkload();

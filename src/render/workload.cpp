@@ -102,15 +102,19 @@ struct alignas(kCacheLine) PacketWorkload::Buffers {
 
 PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
                                const ShadingOptions& shading)
-    : scene_(&scene), frame_(frame_shading(scene, camera, shading)),
-      buffers_(std::make_unique<Buffers>()) {
+    : PacketWorkload(scene, frame_shading(scene, camera, shading), max_pixels) {}
+
+PacketWorkload::PacketWorkload(const Scene& scene, const FrameShading& frame, std::size_t max_pixels)
+    : scene_(&scene), frame_(frame), buffers_(std::make_unique<Buffers>()) {
     Buffers& b = *buffers_;
     b.order.reserve(max_pixels);
     b.pixel.reserve(max_pixels);
     b[RayKind::primary].reserve(max_pixels);
-    switch (shading.shading) {
+    switch (frame.shading.shading) {
         case Shading::direct: b[RayKind::shadow].reserve(max_pixels); break;
-        case Shading::ao: b[RayKind::ao].reserve(max_pixels * static_cast<std::size_t>(shading.ao_samples)); break;
+        case Shading::ao:
+            b[RayKind::ao].reserve(max_pixels * static_cast<std::size_t>(frame.shading.ao_samples));
+            break;
         case Shading::diffuse:
             for (RayKind k : {RayKind::shadow, RayKind::bounce, RayKind::bounce_shadow}) b[k].reserve(max_pixels);
             break;
