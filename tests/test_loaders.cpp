@@ -2,7 +2,13 @@
 // malformed input gives its one exact message naming the file and the line, element or field.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
+#include <future>
 #include <bit>
 #include <cstring>
 #include <filesystem>
@@ -149,6 +155,36 @@ TEST_F(LoaderTest, MissingFileIsNamed) {
     const std::string path = (dir_ / "absent.obj").string();
     EXPECT_EQ(error_of([&] { load_obj(path); }), path + ": cannot open file for reading");
     EXPECT_EQ(error_of([&] { load_scene(path); }), path + ": no such file");
+}
+
+// A named pipe is refused, not opened: opening it would wait for a writer that never comes (the
+// glTF's buffers too, whose existence tinygltf checked by opening them). Should a load still block,
+// the test opens the pipe's other end to free it, and fails.
+TEST_F(LoaderTest, NamedPipesAreRefusedNotWaitedOn) {
+    const std::string fifo_obj = (dir_ / "pipe.obj").string(), fifo_bin = (dir_ / "pipe.bin").string();
+    ASSERT_EQ(::mkfifo(fifo_obj.c_str(), 0600), 0);
+    ASSERT_EQ(::mkfifo(fifo_bin.c_str(), 0600), 0);
+    const std::string gltf = write("buffer.gltf", R"({"asset": {"version": "2.0"},
+        "buffers": [{"uri": "pipe.bin", "byteLength": 36}]})");
+    const nlohmann::json view = {{"mesh", "pipe.obj"},
+                       {"camera", {{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 45}}},
+                       {"light", {{"position", {0, 5, 5}}, {"color", {1, 1, 1}}}},
+                       {"image", {{"width", 8}, {"height", 8}}}};
+    const std::string view_path = write("view.json", view.dump());
+    auto refused = [&](const std::string& path, const std::string& pipe) {
+        auto load = std::async(std::launch::async, [&] { return error_of([&] { load_scene(path); }); });
+        if (load.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+            const int fd = ::open(pipe.c_str(), O_WRONLY | O_NONBLOCK);  // the waiting reader's writer
+            if (fd >= 0) ::close(fd);
+            ADD_FAILURE() << path << ": the load waited on the pipe";
+        }
+        return load.get();
+    };
+    const std::string why = ": is not a regular file (a pipe, socket or device)";
+    EXPECT_EQ(refused(fifo_obj, fifo_obj), fifo_obj + why);
+    EXPECT_EQ(refused(view_path, fifo_obj), fifo_obj + why);  // the view file's mesh
+    const std::string gltf_error = refused(gltf, fifo_bin);
+    EXPECT_NE(gltf_error.find("pipe.bin: not a regular file"), std::string::npos) << gltf_error;
 }
 
 TEST_F(LoaderTest, EmptyMeshIsAnError) {
@@ -674,6 +710,9 @@ TEST_F(LoaderTest, ViewFileRejectsWrongTypes) {
         {[](json& d) { d["light"]["type"] = "spot"; }, "field 'light.type' must be \"point\""},
         {[](json& d) { d["image"]["width"] = 0; }, "field 'image.width' must be an integer in [1, 65536]"},
         {[](json& d) { d["image"]["height"] = 12.5; }, "field 'image.height' must be an integer in [1, 65536]"},
+        // Finite doubles beyond float's range: infinite once read as floats.
+        {[](json& d) { d["light"]["position"] = {0, 1e39, 0}; }, "the light position is not finite"},
+        {[](json& d) { d["light"]["color"] = {1e39, 1, 1}; }, "the light color is not finite"},
     };
     for (const Case& c : cases) {
         json doc = view_doc();

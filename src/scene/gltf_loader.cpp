@@ -44,6 +44,13 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
     return true;
 }
 
+// Whether a file tinygltf asks for exists, told without opening it: tinygltf's own check opens it,
+// which waits for ever on a named pipe.
+bool file_present(const std::string& path, void*) {
+    std::error_code ec;
+    return std::filesystem::exists(path, ec);
+}
+
 // Column-major 4x4, as glTF writes matrices; double so that a chain of transforms rounds once.
 using Matrix = std::array<double, 16>;
 
@@ -135,7 +142,7 @@ private:
         loader.SetImageLoader([](tinygltf::Image*, int, std::string*, std::string*, int, int, const unsigned char*,
                                  int, void*) { return true; },
                               nullptr);
-        loader.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_whole_file,
+        loader.SetFsCallbacks({&file_present, &tinygltf::ExpandFilePath, &read_whole_file,
                                &tinygltf::WriteWholeFile, nullptr});
         std::string err, warn;
         const std::string ext = lower_extension(path_);

@@ -10,9 +10,14 @@
 
 namespace cellrt::detail {
 
+// Reads only a regular file (after symbolic links): opening a named pipe would wait for a writer that
+// may never come, a device may never end.
 inline std::string read_file(const std::string& path) {
     std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not a file");
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(st)) throw Error(path + ": is a folder, not a file");
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+        throw Error(path + ": is not a regular file (a pipe, socket or device)");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open file for reading");
     std::ostringstream ss;

@@ -40,6 +40,8 @@ void validate_scene(const Scene& scene, const std::string& where) {
     try {
         check_finite(scene.triangles);
         if (!is_finite(scene.light.position)) throw Error("the light position is not finite");
+        // A colour past float's range (1e39 in a view file) would shade pixels infinite.
+        if (!is_finite(scene.light.color)) throw Error("the light color is not finite");
         PinholeCamera(scene.camera, scene.width, scene.height);
     } catch (const Error& e) {
         throw Error(where + ": " + e.what());
