@@ -254,8 +254,9 @@ cellrt_error cellrt_device_get_error(cellrt_device device, const char** message)
         return CELLRT_SUCCESS;
     }
     const cellrt_error code = it->second.code;
+    // Once read, the error is gone: "" from then on. Its text stays where the last call pointed.
+    if (message) *message = code == CELLRT_SUCCESS ? "" : it->second.message.c_str();
     it->second.code = CELLRT_SUCCESS;
-    if (message) *message = it->second.message.c_str();
     return code;
 }
 

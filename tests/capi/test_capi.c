@@ -32,7 +32,10 @@ static void check_error(cellrt_device device, cellrt_error code, const char* par
                 part, cellrt_error_name(got), message ? message : "(null)");
         ++failures;
     }
-    CHECK(cellrt_device_get_error(device, NULL) == CELLRT_SUCCESS); /* reading resets the code */
+    /* Reading resets the code; the message read again is "" (the text read before stays valid). */
+    const char* again = NULL;
+    CHECK(cellrt_device_get_error(device, &again) == CELLRT_SUCCESS && again && strcmp(again, "") == 0);
+    CHECK(message && strstr(message, part) != NULL);
 }
 
 /* A deterministic generator (64-bit LCG), so that every run traces the same rays. */
