@@ -331,6 +331,27 @@ TEST(Embree, RaysOutsideEmbreesDomainAreRefused) {
     EXPECT_THROW(make_accelerator(std::span(&far_away, 1), embree_config()), Error);
 }
 
+// Embree picks its own instruction set, but a SIMD set named for it is one of the names, as for
+// every other kind ("embree+banana" was taken and printed back).
+TEST(Embree, ASimdSetNamedForItIsChecked) {
+    const Triangle tri{{-1.f, -1.f, 0.f}, {1.f, -1.f, 0.f}, {0.f, 1.f, 0.f}};
+    AccelConfig config = embree_config();
+    for (const std::string simd : {"auto", "off", "portable"}) {
+        config.simd = simd;
+        EXPECT_NO_THROW(make_accelerator(std::span(&tri, 1), config)) << simd;
+    }
+    for (const std::string simd : {"banana", "AVX2", ""}) {
+        config.simd = simd;
+        try {
+            make_accelerator(std::span(&tri, 1), config);
+            ADD_FAILURE() << "'" << simd << "' taken";
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()),
+                      "SIMD instruction set '" + simd + "' is not one of: auto, off, portable, sse, avx2, avx512");
+        }
+    }
+}
+
 // A height field of quads split into triangles that share vertices exactly, and rays from above aimed
 // at points of its inner edges and at its inner vertices: each ray must hit it. Embree's robust
 // Pluecker test evaluates a shared edge identically for both triangles, so no ray through an edge
