@@ -107,6 +107,7 @@ RayInput ray_input(py::handle origins, py::handle directions, py::handle tnear, 
 std::size_t intersect(const Accelerator& accel, const Team& team, const RayInput& in, HitOutput out) {
     return for_valid_chunks(team, in, [&](std::span<const Ray> rays, std::size_t begin) {
         thread_local std::vector<Hit> hits(kChunk);
+        if (accel.refuses_rays()) accel.check_rays(rays, begin);  // names the caller's index, not the chunk's
         accel.intersect(rays, std::span<Hit>(hits.data(), rays.size()));
         float* t = out.t + begin;
         std::int64_t* prim = out.prim + begin;
@@ -124,6 +125,7 @@ std::size_t intersect(const Accelerator& accel, const Team& team, const RayInput
 
 std::size_t occluded(const Accelerator& accel, const Team& team, const RayInput& in, std::uint8_t* out) {
     return for_valid_chunks(team, in, [&](std::span<const Ray> rays, std::size_t begin) {
+        if (accel.refuses_rays()) accel.check_rays(rays, begin);
         accel.occluded(rays, std::span<std::uint8_t>(out + begin, rays.size()));
     });
 }

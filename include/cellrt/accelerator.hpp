@@ -100,6 +100,16 @@ public:
 
     virtual AccelStats stats() const = 0;
 
+    // Whether some rays are refused (Embree: a negative tnear, a component beyond its range), not
+    // answered; every other kind answers every ray. check_rays() throws cellrt::Error for the first
+    // ray of `rays` refused, naming it as ray first + i: a caller that traces a large batch in pieces
+    // checks the whole batch first, so that a refusal writes no answer and names the caller's index.
+    virtual bool refuses_rays() const { return false; }
+    virtual void check_rays(std::span<const Ray> rays, std::size_t first = 0) const {
+        static_cast<void>(rays);
+        static_cast<void>(first);
+    }
+
 private:
     // What each structure implements, called by intersect() and occluded() with spans of equal length,
     // so that no structure has to check them again.

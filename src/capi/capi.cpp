@@ -159,7 +159,19 @@ void chunks(std::size_t count, LoadRay&& load, auto&& trace) {
     }
 }
 
+// Rays the accelerator refuses (Embree's domain) are found before any is traced, so that a refusal
+// writes no answer and names the caller's index.
+void check_all(const Accelerator& accel, std::size_t count, auto&& load) {
+    if (!accel.refuses_rays()) return;
+    try {
+        chunks(count, load, [&](std::size_t b, std::span<const Ray> rays) { accel.check_rays(rays, b); });
+    } catch (const Error& e) {
+        fail(CELLRT_ERROR_INVALID_ARGUMENT, e.what());
+    }
+}
+
 void intersect_all(const Accelerator& accel, std::size_t count, auto&& load, auto&& store) {
+    check_all(accel, count, load);
     std::vector<Hit> hits(std::min(count, kChunk));
     chunks(count, load, [&](std::size_t b, std::span<const Ray> rays) {
         accel.intersect(rays, std::span(hits.data(), rays.size()));
@@ -169,6 +181,7 @@ void intersect_all(const Accelerator& accel, std::size_t count, auto&& load, aut
 }
 
 void occluded_all(const Accelerator& accel, std::size_t count, auto&& load, std::uint8_t* out) {
+    check_all(accel, count, load);
     chunks(count, load, [&](std::size_t b, std::span<const Ray> rays) {
         accel.occluded(rays, std::span(out + b, rays.size()));
     });

@@ -247,6 +247,11 @@ public:
         return s;
     }
 
+    bool refuses_rays() const override { return true; }
+    void check_rays(std::span<const Ray> rays, std::size_t first) const override {
+        for (std::size_t i = 0; i < rays.size(); ++i) static_cast<void>(admit(rays[i], first + i));
+    }
+
 private:
     void do_intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters) const override {
         switch (options_.width) {

@@ -458,6 +458,37 @@ static int part_errors(void) {
     CHECK(cellrt_intersect_soa(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
     CHECK(cellrt_occluded_soa(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
 
+    /* Rays Embree refuses (a negative tnear) are found before any ray is traced: nothing is written,
+     * the code is INVALID_ARGUMENT and the message names the caller's index, not the index within the
+     * chunk the call traced it in. Where cellrt was built without Embree there is no such accelerator. */
+    {
+        enum { kRays = 20000, kBad = 19000 };
+        static cellrt_ray rays[kRays];
+        static cellrt_hit hits[kRays];
+        static uint8_t occluded[kRays];
+        cellrt_accel embree = cellrt_accel_new(scene, "embree");
+        size_t i;
+        int untouched = 1;
+        if (!embree) {
+            CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "unknown accelerator 'embree'");
+        } else {
+            for (i = 0; i < kRays; ++i) rays[i] = ray;
+            rays[kBad].tnear = -1.f;
+            memset(hits, 0xAB, sizeof hits);
+            memset(occluded, 0xAB, sizeof occluded);
+            CHECK(cellrt_intersect(embree, rays, hits, kRays) == CELLRT_ERROR_INVALID_ARGUMENT);
+            CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "ray 19000 of the batch has tnear -1");
+            CHECK(cellrt_occluded(embree, rays, occluded, kRays) == CELLRT_ERROR_INVALID_ARGUMENT);
+            CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "ray 19000 of the batch has tnear -1");
+            for (i = 0; i < sizeof hits; ++i) untouched &= ((const unsigned char*)hits)[i] == 0xAB;
+            for (i = 0; i < kRays; ++i) untouched &= occluded[i] == 0xAB;
+            CHECK(untouched);
+            rays[kBad].tnear = 0.f;
+            CHECK(cellrt_occluded(embree, rays, occluded, kRays) == CELLRT_SUCCESS && occluded[kBad] == 1);
+            CHECK(cellrt_accel_release(embree) == CELLRT_SUCCESS);
+        }
+    }
+
     /* The error function: called with the code and the message on a failure, not once unset. */
     CHECK(cellrt_device_set_error_function(NULL, on_error, &calls) == CELLRT_ERROR_INVALID_HANDLE);
     CHECK_ERROR(NULL, CELLRT_ERROR_INVALID_HANDLE, "cellrt_device_set_error_function: device is NULL");

@@ -125,6 +125,17 @@ def test_the_first_bad_ray_is_named(acc):
     refused(r"origins\[1500\] is not finite", acc.intersect, o, np.tile(D, (3000, 1)))
 
 
+@pytest.mark.skipif("embree" not in cellrt.kinds(), reason="cellrt was built without Embree")
+def test_a_ray_embree_refuses_is_named_by_its_index_in_the_call():
+    embree = cellrt.Accelerator(TRI, kind="embree")
+    tnear = np.zeros(4000, np.float32)
+    tnear[2500] = -1  # the third of the call's chunks of 1024 rays
+    with pytest.raises(cellrt.Error, match=r"ray 2500 of the batch has tnear -1; Embree needs tnear >= 0"):
+        embree.intersect(np.tile(O, (1000, 1)), np.tile(D, (1000, 1)), tnear=tnear)
+    with pytest.raises(cellrt.Error, match="ray 2500 of the batch"):
+        embree.occluded(np.tile(O, (1000, 1)), np.tile(D, (1000, 1)), tnear=tnear)
+
+
 def test_infinite_bounds_and_degenerate_rays_are_valid(acc):
     r = acc.intersect(O, D, tnear=-np.inf, tfar=np.inf)
     assert r["prim"].tolist() == [0, 0, 0, 0]
