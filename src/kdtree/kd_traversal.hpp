@@ -126,7 +126,11 @@ CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     KdTraits::Leaves leaves;
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
-    const float reach = r.margin * length(r.dir);
+    // Where the direction's length squared under- or overflows (components below 1e-19 or above
+    // 1e19), the margin is infinite or zero and this 0 * inf: no tolerance is known then, and an
+    // infinite one visits every cell the interval reaches.
+    float reach = r.margin * length(r.dir);
+    if (!(reach == reach)) reach = kInfinity;
     const Vec3 o = abs(r.org);
     const float tol = reach + kMarginScale * std::max(o.x, std::max(o.y, o.z));
     Point stack[kKdRecStackSize];
