@@ -278,6 +278,7 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
          "--accel 'bih:branched+auto' names a single-ray kernel, which the SIMD packets of --accel "
          "'bih:branched+auto' replace: leave one of them out"},
         {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
+        {{"info", dir.path.string()}, dir.path.string() + ": is a folder, not a file"},  // no extension
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
         {{"render", spheres, "-o", out, "--stats", (dir.path / "no" / "s.json").string()},
          (dir.path / "no" / "s.json").string() + ": no folder " + (dir.path / "no").string() + " to write it in"},

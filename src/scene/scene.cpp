@@ -59,6 +59,9 @@ std::vector<Triangle> load_mesh(const std::string& path) {
 Scene load_scene(const std::string& spec) {
     if (spec.rfind("builtin:", 0) == 0) return make_builtin_scene(spec);
     if (!detail::file_exists(spec)) throw Error(spec + ": no such file");
+    // Before the extension decides the format: a folder named without one ("." or "/tmp") would be
+    // "an unknown mesh format ''".
+    if (std::error_code ec; std::filesystem::is_directory(spec, ec)) throw Error(spec + ": is a folder, not a file");
     if (lower_extension(spec) == ".json") return load_view_file(spec);
     Scene scene;
     scene.name = std::filesystem::path(spec).stem().string();
