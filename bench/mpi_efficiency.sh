@@ -11,7 +11,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${CELLRT_BUILD:-$root/build}"
 scene="$1"; reps="${2:-7}"; size="${3:-1920x1080}"
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 LC_ALL=C  # EPOCHREALTIME's decimal point
 work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
 declare -A cmd=(
   [plain_2threads]="$build/cellrt render $scene --threads 2"

@@ -7,6 +7,7 @@
 
 #include <time.h>
 
+#include "cellrt/error.hpp"
 #include "core/timer.hpp"
 
 namespace cellrt::python {
@@ -104,10 +105,37 @@ RayInput ray_input(py::handle origins, py::handle directions, py::handle tnear, 
     return in;
 }
 
+namespace {
+
+// for_valid_chunks for an accelerator that may refuse rays (Embree's domain): a chunk holding one is
+// not traced, and once every chunk is done the lowest such chunk is checked again, so that the error
+// names the call's first refused ray by its index in the call, whichever thread met which chunk first.
+template <class Trace>
+std::size_t for_admitted_chunks(const Accelerator& accel, const Team& team, const RayInput& in, Trace&& trace) {
+    if (!accel.refuses_rays()) return for_valid_chunks(team, in, trace);
+    std::atomic<std::size_t> refused{kAllValid};
+    const std::size_t first_invalid = for_valid_chunks(team, in, [&](std::span<const Ray> rays, std::size_t begin) {
+        try {
+            accel.check_rays(rays, begin);
+        } catch (const Error&) {
+            keep_lowest(refused, begin);
+            return;
+        }
+        trace(rays, begin);
+    });
+    if (const std::size_t begin = refused.load(); begin != kAllValid) {
+        std::vector<Ray> rays(std::min(in.count - begin, kChunk));
+        assemble(in, begin, begin + rays.size(), rays.data());
+        accel.check_rays(rays, begin);  // throws, naming the ray
+    }
+    return first_invalid;
+}
+
+}  // namespace
+
 std::size_t intersect(const Accelerator& accel, const Team& team, const RayInput& in, HitOutput out) {
-    return for_valid_chunks(team, in, [&](std::span<const Ray> rays, std::size_t begin) {
+    return for_admitted_chunks(accel, team, in, [&](std::span<const Ray> rays, std::size_t begin) {
         thread_local std::vector<Hit> hits(kChunk);
-        if (accel.refuses_rays()) accel.check_rays(rays, begin);  // names the caller's index, not the chunk's
         accel.intersect(rays, std::span<Hit>(hits.data(), rays.size()));
         float* t = out.t + begin;
         std::int64_t* prim = out.prim + begin;
@@ -124,8 +152,7 @@ std::size_t intersect(const Accelerator& accel, const Team& team, const RayInput
 }
 
 std::size_t occluded(const Accelerator& accel, const Team& team, const RayInput& in, std::uint8_t* out) {
-    return for_valid_chunks(team, in, [&](std::span<const Ray> rays, std::size_t begin) {
-        if (accel.refuses_rays()) accel.check_rays(rays, begin);
+    return for_admitted_chunks(accel, team, in, [&](std::span<const Ray> rays, std::size_t begin) {
         accel.occluded(rays, std::span<std::uint8_t>(out + begin, rays.size()));
     });
 }

@@ -103,7 +103,8 @@ public:
     // Whether some rays are refused (Embree: a negative tnear, a component beyond its range), not
     // answered; every other kind answers every ray. check_rays() throws cellrt::Error for the first
     // ray of `rays` refused, naming it as ray first + i: a caller that traces a large batch in pieces
-    // checks the whole batch first, so that a refusal writes no answer and names the caller's index.
+    // checks each piece with its offset, so that the error names the caller's index (the C API checks
+    // the whole batch before tracing any, so that a refusal writes no answer).
     virtual bool refuses_rays() const { return false; }
     virtual void check_rays(std::span<const Ray> rays, std::size_t first = 0) const {
         static_cast<void>(rays);

@@ -36,6 +36,7 @@ template <class T>
 class ZeroedArray {
     static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>,
                   "ZeroedArray holds trivially copyable elements whose zero is all bits zero");
+    static_assert(alignof(T) <= alignof(std::max_align_t), "calloc aligns for max_align_t only");
 
 public:
     using value_type = T;

@@ -16,8 +16,22 @@ constexpr std::size_t kMapFrom = std::size_t{4} << 20;
 
 }  // namespace
 
+// AddressSanitizer's allocator puts red zones around a block; a mapping of its own would have none
+// (and up to 2 MiB of slack past its end), so under it every block comes from calloc.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kOwnMappings = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kOwnMappings = false;
+#else
+constexpr bool kOwnMappings = true;
+#endif
+#else
+constexpr bool kOwnMappings = true;
+#endif
+
 ZeroedBlock allocate_zeroed(std::size_t bytes) {
-    if (bytes < kMapFrom) {
+    if (bytes < kMapFrom || !kOwnMappings) {
         void* p = std::calloc(bytes, 1);
         if (!p) throw std::bad_alloc();
         return {p, 0};

@@ -128,7 +128,8 @@ CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
     // Where the direction's length squared under- or overflows (components below 1e-19 or above
     // 1e19), the margin is infinite or zero and this 0 * inf: no tolerance is known then, and an
-    // infinite one visits every cell the interval reaches.
+    // infinite one visits every cell the interval reaches (with an infinite margin the interval is
+    // (-inf, inf), and the points at its ends have NaN coordinates where the direction is 0).
     float reach = r.margin * length(r.dir);
     if (!(reach == reach)) reach = kInfinity;
     const Vec3 o = abs(r.org);
@@ -150,7 +151,9 @@ CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay
             const int a = n.axis();
             const float s = n.split();
             const float p0 = stack[en].entry[a], p1 = stack[ex].exit[a];
-            const bool left_ok = std::min(p0, p1) <= s + tol, right_ok = std::max(p0, p1) >= s - tol;
+            // A NaN coordinate (an infinite t along an axis the direction does not move on) passes
+            // both tests: both children are visited.
+            const bool left_ok = !(std::min(p0, p1) > s + tol), right_ok = !(std::max(p0, p1) < s - tol);
             if (!right_ok) {
                 index = n.children();
             } else if (!left_ok) {

@@ -26,6 +26,8 @@ public:
     MeasuredAccelerator(const Accelerator& inner, Counting counting) : inner_(inner), counting_(counting) {}
 
     AccelStats stats() const override { return inner_.stats(); }
+    bool refuses_rays() const override { return inner_.refuses_rays(); }
+    void check_rays(std::span<const Ray> rays, std::size_t first) const override { inner_.check_rays(rays, first); }
 
     // The sums over all calls so far (hardware counting; zero before the first call).
     EventCounts counts() const;

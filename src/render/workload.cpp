@@ -25,10 +25,18 @@ const char* to_string(Shading s) { return detail::name_of(kShadings, s); }
 std::vector<std::string> shading_names() { return detail::names_of(kShadings); }
 const char* to_string(RayKind k) { return detail::name_of(kRayKindNames, k); }
 
+namespace {
+
+void check_ao_samples(int samples) {
+    if (samples < 1 || samples > kMaxAoSamples)
+        throw Error("AO samples " + std::to_string(samples) + " must lie in [1, " + std::to_string(kMaxAoSamples) +
+                    "]");
+}
+
+}  // namespace
+
 FrameShading frame_shading(const Scene& scene, const PinholeCamera& camera, const ShadingOptions& shading) {
-    if (shading.ao_samples < 1 || shading.ao_samples > kMaxAoSamples)
-        throw Error("AO samples " + std::to_string(shading.ao_samples) + " must lie in [1, " +
-                    std::to_string(kMaxAoSamples) + "]");
+    check_ao_samples(shading.ao_samples);
     FrameShading f;
     f.camera = camera.projection();
     f.light_position = scene.light.position;
@@ -106,6 +114,7 @@ PacketWorkload::PacketWorkload(const Scene& scene, const PinholeCamera& camera, 
 
 PacketWorkload::PacketWorkload(const Scene& scene, const FrameShading& frame, std::size_t max_pixels)
     : scene_(&scene), frame_(frame), buffers_(std::make_unique<Buffers>()) {
+    check_ao_samples(frame.shading.ao_samples);  // a FrameShading made by hand
     Buffers& b = *buffers_;
     b.order.reserve(max_pixels);
     b.pixel.reserve(max_pixels);
