@@ -18,7 +18,6 @@
 #include "cellrt/error.hpp"
 #include "kernel/named.hpp"
 #include "localstore/model_accelerator.hpp"
-#include "simd/isa.hpp"
 #ifdef CELLRT_HAVE_EMBREE
 #include "embree/embree_accel.hpp"
 #endif
@@ -56,13 +55,7 @@ std::vector<Entry> make_entries() {
                        &bvh_params(), bvh_traversals()});
     entries.push_back({"auto", &detail::make_routed, &detail::routed_params(), detail::routed_traversals()});
 #ifdef CELLRT_HAVE_EMBREE
-    // Embree picks its own instruction set; a SIMD set named for it is still checked, as for every kind.
-    entries.push_back({"embree",
-                       [](std::span<const Triangle> triangles, const AccelConfig& config) {
-                           if (config.simd != "off") static_cast<void>(detail::parse_isa(config.simd));
-                           return make_embree(triangles, config);
-                       },
-                       &embree_params(), embree_traversals()});
+    entries.push_back({"embree", &make_embree, &embree_params(), embree_traversals()});
 #endif
 #ifdef CELLRT_HAVE_CUDA
     for (const detail::DeviceEntry& d : detail::cuda_factories())

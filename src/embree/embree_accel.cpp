@@ -16,6 +16,7 @@
 #include "core/timer.hpp"
 #include "kernel/param_reader.hpp"
 #include "kernel/subtree.hpp"
+#include "simd/isa.hpp"
 
 namespace cellrt {
 namespace {
@@ -472,6 +473,8 @@ const std::vector<std::string>& embree_traversals() {
 }
 
 std::unique_ptr<Accelerator> make_embree(std::span<const Triangle> triangles, const AccelConfig& config) {
+    // Embree picks its own instruction set; a SIMD set named for it is still checked, as for every kind.
+    if (config.simd != "off") static_cast<void>(detail::parse_isa(config.simd));
     detail::ParamReader params(embree_params(), config, "embree");
     EmbreeOptions options;
     options.quality = params.choice("quality");

@@ -125,13 +125,9 @@ CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay
     float tmin, tmax;
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     KdTraits::Leaves leaves;
-    // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved.
-    // Where the direction's length squared under- or overflows (components below 1e-19 or above
-    // 1e19), the margin is infinite or zero and this 0 * inf: no tolerance is known then, and an
-    // infinite one visits every cell the interval reaches (with an infinite margin the interval is
-    // (-inf, inf), and the points at its ends have NaN coordinates where the direction is 0).
-    float reach = r.margin * length(r.dir);
-    if (!(reach == reach)) reach = kInfinity;
+    // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved
+    // (KdRecKernel sends the rays for which this is 0 * inf elsewhere).
+    const float reach = r.margin * length(r.dir);
     const Vec3 o = abs(r.org);
     const float tol = reach + kMarginScale * std::max(o.x, std::max(o.y, o.z));
     Point stack[kKdRecStackSize];
@@ -151,9 +147,7 @@ CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay
             const int a = n.axis();
             const float s = n.split();
             const float p0 = stack[en].entry[a], p1 = stack[ex].exit[a];
-            // A NaN coordinate (an infinite t along an axis the direction does not move on) passes
-            // both tests: both children are visited.
-            const bool left_ok = !(std::min(p0, p1) > s + tol), right_ok = !(std::max(p0, p1) < s - tol);
+            const bool left_ok = std::min(p0, p1) <= s + tol, right_ok = std::max(p0, p1) >= s - tol;
             if (!right_ok) {
                 index = n.children();
             } else if (!left_ok) {
@@ -198,6 +192,13 @@ enum class KdTraversal { rec, branched, branchless };
 struct KdRecKernel {
     template <class Tree, class Memory, class Query, class Counters>
     CELLRT_HD bool operator()(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) const {
+        // Where the direction's length squared under- or overflows (components below 1e-19 or above
+        // 1e19), the margin is infinite or zero and TA_rec's coordinate tolerance, margin times that
+        // length, is 0 * inf: no bound on its points' coordinates is known. Such a ray takes the
+        // interval traversal, whose tests are on t alone (checked here, so that TA_rec's own code,
+        // the study's, stays as it was).
+        const float reach = r.margin * length(r.dir);
+        if (!(reach == reach)) return traverse_branched<KdTraits>(tree, mem, r, q, c);
         return kd_traverse_rec(tree, mem, r, q, c);
     }
 };
