@@ -14,21 +14,22 @@ namespace {
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kMapFrom = std::size_t{4} << 20;
 
-}  // namespace
-
 // AddressSanitizer's allocator puts red zones around a block; a mapping of its own would have none
-// (and up to 2 MiB of slack past its end), so under it every block comes from calloc.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kOwnMappings = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+// (and up to 2 MiB of slack past its end), so under it every block comes from calloc (GCC defines
+// __SANITIZE_ADDRESS__, clang answers __has_feature).
+#if !defined(__has_feature)
+#define CELLRT_HAS_FEATURE(x) 0
+#else
+#define CELLRT_HAS_FEATURE(x) __has_feature(x)
+#endif
+#if defined(__SANITIZE_ADDRESS__) || CELLRT_HAS_FEATURE(address_sanitizer)
 constexpr bool kOwnMappings = false;
 #else
 constexpr bool kOwnMappings = true;
 #endif
-#else
-constexpr bool kOwnMappings = true;
-#endif
+#undef CELLRT_HAS_FEATURE
+
+}  // namespace
 
 ZeroedBlock allocate_zeroed(std::size_t bytes) {
     if (bytes < kMapFrom || !kOwnMappings) {

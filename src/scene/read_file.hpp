@@ -17,8 +17,6 @@ namespace cellrt::detail {
 // never come, a device may never end. The file is opened without waiting (O_NONBLOCK, which regular
 // files ignore) and what was opened is checked, so a pipe put in its place meanwhile is refused too.
 inline std::string read_file(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not a file");
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) throw Error(path + ": cannot open file for reading");
     const struct Closer {
