@@ -24,9 +24,6 @@ typedef std::uint32_t URow __attribute__((vector_size(4 * kLanes), aligned(4), m
 inline F load(const float* p) { return *reinterpret_cast<const FRow*>(p); }
 inline U load_u(const std::uint32_t* p) { return *reinterpret_cast<const URow*>(p); }
 
-// The direction's sign bits (x, y, z in bits 0-2), as TraversalRay::dir_neg holds them: the octant.
-inline unsigned octant_bits(const TraversalRay& r) { return r.dir_neg[0] | r.dir_neg[1] << 1 | r.dir_neg[2] << 2; }
-
 // The ray as the box tests of every node see it: its origin and reciprocal direction in all lanes,
 // its tnear and margin, and for each axis the offset (in floats, from the node's lo[0]) of the planes
 // it enters and leaves a box by, chosen once by the direction's sign.
@@ -35,7 +32,7 @@ struct BoxRay {
     float tnear, margin;
     int enter[3], leave[3];
 
-    explicit BoxRay(const TraversalRay& r) : BoxRay(r.org, r.inv_dir, octant_bits(r), r.tnear, r.margin) {}
+    explicit BoxRay(const TraversalRay& r) : BoxRay(r.org, r.inv_dir, r.octant(), r.tnear, r.margin) {}
     // From the origin and reciprocal direction (anything indexed by axis: a stream's stored ray,
     // bvh_stream.inl, keeps them as floats) and the direction's sign bits.
     template <class Origin, class Inverse>

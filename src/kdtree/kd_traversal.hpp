@@ -118,8 +118,11 @@ struct KdRecPoint {
 static_assert(sizeof(KdRecPoint) == 40, "the local-store model budgets TA_rec's stack at 40 bytes a point");
 inline constexpr int kKdRecStackSize = kKdMaxDepth + 3;
 
+// Flattened (every call inlined) on hosts: left to GCC's budget in the registry's unit, where every
+// tree's kernels are instantiated, the leaf test went in or out of line with changes to other
+// kernels, 8 % of TA_rec's instructions on Sponza's camera rays (docs/INCOHERENT.md).
 template <class Tree, class Query, class Memory, class Counters>
-CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
+[[gnu::flatten]] CELLRT_HD bool kd_traverse_rec(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) {
     constexpr std::uint32_t kNone = ~0u;
     using Point = KdRecPoint;
     float tmin, tmax;

@@ -46,6 +46,7 @@ CELLRT_HD bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query&
     typename Traits::Leaves leaves;
     StackEntry stack[kBranchedStackSize<Traits>];
     int sp = 0;
+    const std::uint32_t octant = r.octant();
     for (;;) {
         typename Traits::Node n = mem.node(index);
         bool reached_leaf = true;
@@ -53,7 +54,7 @@ CELLRT_HD bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query&
             c.node();
             mem.touch_node(n.children());
             const int a = n.axis();
-            const std::uint32_t s = r.dir_neg[a];
+            const std::uint32_t s = (octant >> a) & 1u;
             const float t_near = (Traits::plane(n, s) - r.org[a]) * r.inv_dir[a];      // where the near child ends
             const float t_far = (Traits::plane(n, s ^ 1u) - r.org[a]) * r.inv_dir[a];  // where the far child begins
             // A NaN distance (the ray lies in the plane) passes both tests: both children are visited.
@@ -93,6 +94,7 @@ CELLRT_HD bool traverse_branchless(const Tree& tree, Memory& mem, const Traversa
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     typename Traits::Leaves leaves;
     StackEntry stack[kBranchlessStackSize<Traits>];
+    const std::uint32_t octant = r.octant();
     int bottom = 0;
     if constexpr (Traits::kGaps) stack[bottom++] = {Traits::kSentinel, tmin, tmax};
     int sp = bottom;
@@ -103,7 +105,7 @@ CELLRT_HD bool traverse_branchless(const Tree& tree, Memory& mem, const Traversa
             c.node();
             mem.touch_node(n.children());
             const int a = n.axis();
-            const std::uint32_t s = r.dir_neg[a];
+            const std::uint32_t s = (octant >> a) & 1u;
             const float t_near = (Traits::plane(n, s) - r.org[a]) * r.inv_dir[a];
             const float t_far = (Traits::plane(n, s ^ 1u) - r.org[a]) * r.inv_dir[a];
             const bool near_ok = !(tmin > t_near + r.margin), far_ok = !(t_far - r.margin > tmax);

@@ -52,6 +52,12 @@ struct TraversalRay {
 
     CELLRT_HD Vec3 at(float t) const { return org + dir * t; }
 
+    // The direction's sign bits (x, y, z in bits 0-2): the octant. A kernel keeps them in a register
+    // and picks the near child by a shift, `(octant >> axis) & 1`, rather than loading dir_neg[axis]:
+    // the pick lies on the chain from one node's load to the next, and a load there costs its latency
+    // on every step (about 10 % of a kd-tree's camera ray on Zen 4: docs/INCOHERENT.md, seventeenth round).
+    CELLRT_HD std::uint32_t octant() const { return dir_neg[0] | dir_neg[1] << 1 | dir_neg[2] << 2; }
+
     // The ray's interval [tnear, tfar] clipped to `box`, both widened by the margin. False when empty.
     // A slab the ray lies in exactly (origin on its face, zero direction on its axis) gives NaN and
     // does not cut the interval.
