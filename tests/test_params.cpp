@@ -133,6 +133,14 @@ TEST(Params, UnknownNamesAndValuesOutOfRangeAreRefused) {
         EXPECT_EQ(error_of("kd", "traversal_cost", v),
                   "kd parameter traversal_cost=" + v + " is out of range " + range_of("kd", "traversal_cost"));
     EXPECT_EQ(error_of("kd", "traversal_cost", "nan"), "kd parameter traversal_cost='nan' is not a number");
+    // The whole text is a decimal number, as in the scene files: no blanks, no hexadecimal (strtod
+    // took both); a leading '+' is read.
+    for (const std::string v : {" 5", "5 ", "0x10", "5,0", "", "1e", ".", "++5"})
+        EXPECT_EQ(error_of("kd", "traversal_cost", v), "kd parameter traversal_cost='" + v + "' is not a number");
+    for (const std::string v : {" 2", "0x2", "2.0", "1e1", ""})
+        EXPECT_EQ(error_of("bih", "leaf_size", v), "bih parameter leaf_size='" + v + "' is not an integer");
+    EXPECT_EQ(error_of("kd", "traversal_cost", "-0"),
+              "kd parameter traversal_cost=-0 is out of range " + range_of("kd", "traversal_cost"));
     for (const std::string v : {"99999999999999999999", "-99999999999999999999", "9223372036854775807"})
         EXPECT_EQ(error_of("bih", "leaf_size", v),
                   "bih parameter leaf_size=" + v + " is out of range " + range_of("bih", "leaf_size"));

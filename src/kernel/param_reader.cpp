@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 
 #include "cellrt/error.hpp"
+#include "core/parse_number.hpp"
 #include "named.hpp"
 
 namespace cellrt::detail {
@@ -58,12 +58,14 @@ const std::string& ParamReader::text(const ParamSpec& spec, const std::string* d
 double ParamReader::number(const std::string& name, const std::string* default_value) {
     const ParamSpec& p = spec(name, ParamType::number);
     const std::string& t = text(p, default_value);
-    char* end = nullptr;
-    const double value = std::strtod(t.c_str(), &end);
-    if (t.empty() || *end != '\0' || std::isnan(value))
+    // Numbers as in the scene files (core/parse_number.hpp): the whole text, decimal, whatever the C
+    // locale (strtod took " 5" and "0x10", and would read "0.05" as 0 where the locale writes "0,05").
+    double value = 0.0;
+    const ParsedNumber parsed = parse_number(t, value);
+    if (parsed == ParsedNumber::Malformed || (parsed == ParsedNumber::Ok && std::isnan(value)))
         throw Error(structure_ + " parameter " + name + "='" + t + "' is not a number");
-    // Infinities, and numbers beyond a double's range (strtod makes them infinite), fail here too.
-    if (!(value >= p.min && value <= p.max))
+    // Infinities, and numbers beyond a double's range, fail here too.
+    if (parsed == ParsedNumber::OutOfRange || !(value >= p.min && value <= p.max))
         throw Error(structure_ + " parameter " + name + "=" + t + " is out of range " + param_range(p));
     return value;
 }
@@ -71,12 +73,11 @@ double ParamReader::number(const std::string& name, const std::string* default_v
 int ParamReader::integer(const std::string& name) {
     const ParamSpec& p = spec(name, ParamType::integer);
     const std::string& t = text(p, nullptr);
-    char* end = nullptr;
-    const long value = std::strtol(t.c_str(), &end, 10);
-    if (t.empty() || *end != '\0')
+    long value = 0;
+    const ParsedNumber parsed = parse_number(t, value);
+    if (parsed == ParsedNumber::Malformed)
         throw Error(structure_ + " parameter " + name + "='" + t + "' is not an integer");
-    // Beyond long's range strtol gives LONG_MIN or LONG_MAX, which no table's range includes.
-    if (static_cast<double>(value) < p.min || static_cast<double>(value) > p.max)
+    if (parsed == ParsedNumber::OutOfRange || static_cast<double>(value) < p.min || static_cast<double>(value) > p.max)
         throw Error(structure_ + " parameter " + name + "=" + t + " is out of range " + param_range(p));
     return static_cast<int>(value);
 }

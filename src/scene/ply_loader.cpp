@@ -16,7 +16,7 @@
 
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
-#include "parse_number.hpp"
+#include "core/parse_number.hpp"
 #include "read_file.hpp"
 #include "text_tokens.hpp"
 

@@ -1,6 +1,7 @@
-// Numbers in text mesh files (internal): std::from_chars (exact, locale-independent, the whole token
-// or nothing) plus what C's strtod also accepts and from_chars does not: a leading '+', and a float
-// too small for its type, which becomes the nearest float (zero or a subnormal) rather than an error.
+// Numbers in text mesh files and in accelerator parameters (internal): std::from_chars (exact,
+// locale-independent, the whole token or nothing) plus what C's strtod also accepts and from_chars
+// does not: a leading '+', and a float too small for its type, which becomes the nearest float (zero
+// or a subnormal) rather than an error.
 #pragma once
 
 #include <charconv>
