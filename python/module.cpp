@@ -30,6 +30,49 @@ struct PyAccelerator {
     AccelConfig config;  // as built
 };
 
+}  // namespace
+}  // namespace cellrt::python
+
+namespace pybind11::detail {
+
+// Every class of the module is read through a caster that refuses an object whose C++ value was
+// never made: `cellrt.Accelerator.__new__(cellrt.Accelerator)` without `__init__` (or `__new__` of a
+// class made only by the library, such as AccelStats) gives an object whose memory pybind11 (2.10)
+// allocated but did not construct, and hands that memory to the methods. pybind11 registers a value
+// when a constructor has made it, or when it wraps one the library owns (`scene.camera`), never
+// before: the registration tells.
+template <class T>
+struct made_caster : type_caster_base<T> {
+    bool load(handle src, bool convert) {
+        if (!type_caster_base<T>::load(src, convert)) return false;
+        if (this->value == nullptr) return true;  // None, where the argument allows it
+        const value_and_holder v_h =
+            reinterpret_cast<instance*>(src.ptr())->get_value_and_holder(get_type_info(typeid(T)), false);
+        if (!v_h || !v_h.instance_registered())
+            throw type_error(std::string(Py_TYPE(src.ptr())->tp_name) +
+                             " object was made by __new__ without __init__: make it by calling the class");
+        return true;
+    }
+};
+
+template <>
+struct type_caster<cellrt::python::PyAccelerator> : made_caster<cellrt::python::PyAccelerator> {};
+template <>
+struct type_caster<cellrt::Scene> : made_caster<cellrt::Scene> {};
+template <>
+struct type_caster<cellrt::Camera> : made_caster<cellrt::Camera> {};
+template <>
+struct type_caster<cellrt::PointLight> : made_caster<cellrt::PointLight> {};
+template <>
+struct type_caster<cellrt::AccelStats> : made_caster<cellrt::AccelStats> {};
+template <>
+struct type_caster<cellrt::TreeReport> : made_caster<cellrt::TreeReport> {};
+
+}  // namespace pybind11::detail
+
+namespace cellrt::python {
+namespace {
+
 std::string param_value(py::handle value, const std::string& name) {
     if (py::isinstance<py::str>(value)) return value.cast<std::string>();
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";

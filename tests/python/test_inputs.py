@@ -198,3 +198,41 @@ def test_a_missing_gpu_is_a_library_error_naming_why():
         with pytest.raises(cellrt.Error) as e:
             call()
         assert str(e.value) == "device 'cuda': " + info["reason"]
+
+
+@pytest.mark.parametrize("cls", [cellrt.Accelerator, cellrt.Scene, cellrt.Camera, cellrt.Light, cellrt.AccelStats,
+                                 cellrt.TreeReport])
+def test_an_object_made_by_new_without_init_is_refused(cls):
+    # Its C++ value was allocated, not constructed: every use is a TypeError, never a read of that memory.
+    unmade = cls.__new__(cls)
+    properties = [n for n in dir(cls) if isinstance(getattr(cls, n), property)]
+    assert properties
+    for name in properties:
+        with pytest.raises(TypeError, match="made by __new__ without __init__"):
+            getattr(unmade, name)
+    made = {cellrt.Accelerator: lambda: cellrt.Accelerator(TRI), cellrt.Scene: lambda: cellrt.Scene(TRI)}
+    if cls in made:
+        with pytest.raises(TypeError, match="made by __new__ without __init__"):
+            repr(unmade)
+        assert repr(made[cls]())
+
+
+def test_an_unmade_object_is_refused_as_an_argument():
+    acc = cellrt.Accelerator.__new__(cellrt.Accelerator)
+    for method in (acc.intersect, acc.occluded):
+        with pytest.raises(TypeError, match="made by __new__ without __init__"):
+            method(O, D)
+    with pytest.raises(TypeError, match="made by __new__ without __init__"):
+        cellrt.Camera.__new__(cellrt.Camera).rays(4, 4)
+    scene = cellrt.Scene.__new__(cellrt.Scene)
+    with pytest.raises(TypeError, match="made by __new__ without __init__"):
+        cellrt.render(scene, size=(4, 4))
+    with pytest.raises(TypeError, match="made by __new__ without __init__"):
+        scene.size = (4, 4)
+    made = cellrt.Scene(TRI)
+    with pytest.raises(TypeError, match="made by __new__ without __init__"):
+        made.camera = cellrt.Camera.__new__(cellrt.Camera)
+    # The objects the library owns and hands out by reference are made ones.
+    made.camera.fov_y_deg = 40.0
+    assert made.camera.fov_y_deg == 40.0
+    assert made.light.position is not None
