@@ -5,7 +5,10 @@
 #include <cstring>
 #include <limits>
 #include <filesystem>
+#include <fcntl.h>
 #include <fstream>
+#include <future>
+#include <sys/stat.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -102,6 +105,33 @@ TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
     EXPECT_NO_THROW(write_image(img, path, true));
     EXPECT_THROW(write_image(img, (dir / "no" / "such" / "x.png").string(), false), Error);
     EXPECT_THROW(write_image(img, (dir / "x.bmp").string(), false), Error);
+    std::filesystem::remove_all(dir);
+}
+
+// read_pfm reads only a regular file, as the loaders do: a folder or a named pipe in the image's place
+// is refused with its name, not opened and waited on.
+TEST(Render, ReadPfmRefusesWhatIsNotARegularFile) {
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_pfm_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto error_of = [](const std::string& path) { return test::error_of([&] { read_pfm(path); }); };
+    const std::string folder = (dir / "folder.pfm").string(), fifo = (dir / "pipe.pfm").string();
+    std::filesystem::create_directories(folder);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_EQ(error_of(folder), folder + ": is a folder, not a file");
+    auto read = std::async(std::launch::async, [&] { return error_of(fifo); });
+    if (read.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+        const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // the waiting reader's writer
+        if (fd >= 0) ::close(fd);
+        ADD_FAILURE() << "read_pfm waited on the pipe";
+    }
+    EXPECT_EQ(read.get(), fifo + ": is not a regular file (a pipe, socket or device)");
+    EXPECT_EQ(error_of((dir / "absent.pfm").string()), (dir / "absent.pfm").string() + ": cannot open file for reading");
+    const std::string truncated = (dir / "short.pfm").string();
+    {
+        std::ofstream out(truncated, std::ios::binary);
+        out << "PF\n4 2\n-1\n" << std::string(12, '\0');
+    }
+    EXPECT_EQ(error_of(truncated), truncated + ": file is truncated");
     std::filesystem::remove_all(dir);
 }
 

@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -12,6 +11,7 @@
 
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
+#include "core/read_file.hpp"
 
 namespace cellrt {
 namespace {
@@ -127,9 +127,10 @@ void write_image(const Image& image, const std::string& path, bool overwrite) {
     write_file_atomically(path, bytes, overwrite);
 }
 
+// Read as the loaders read (core/read_file.hpp): only a regular file, so that a pipe or a device in
+// the image's place is refused rather than waited on.
 Image read_pfm(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open file for reading");
+    std::istringstream in(detail::read_file(path), std::ios::binary);
     std::string magic;
     int w = 0, h = 0;
     double scale = 0.0;

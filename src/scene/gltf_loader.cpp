@@ -16,7 +16,7 @@
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
 #include "cellrt/loaders.hpp"
-#include "scene/read_file.hpp"
+#include "core/read_file.hpp"
 
 namespace cellrt {
 namespace {

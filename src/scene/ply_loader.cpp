@@ -17,7 +17,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
 #include "core/parse_number.hpp"
-#include "read_file.hpp"
+#include "core/read_file.hpp"
 #include "text_tokens.hpp"
 
 namespace cellrt {

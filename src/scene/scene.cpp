@@ -11,7 +11,7 @@
 #include "core/files.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
-#include "read_file.hpp"
+#include "core/read_file.hpp"
 
 namespace cellrt {
 

@@ -8,7 +8,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
-#include "read_file.hpp"
+#include "core/read_file.hpp"
 
 namespace cellrt {
 namespace {

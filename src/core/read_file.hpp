@@ -1,4 +1,4 @@
-// Whole-file reading and existence for the loaders (internal).
+// Whole-file reading and existence, for the loaders and read_pfm (internal).
 #pragma once
 
 #include <fcntl.h>
