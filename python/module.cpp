@@ -46,9 +46,11 @@ struct made_caster : type_caster_base<T> {
     bool load(handle src, bool convert) {
         if (!type_caster_base<T>::load(src, convert)) return false;
         if (this->value == nullptr) return true;  // None, where the argument allows it
+        // A value converted from another object (none of the module's classes allows it today) was made.
+        if (!PyObject_TypeCheck(src.ptr(), reinterpret_cast<PyTypeObject*>(get_internals().instance_base))) return true;
         const value_and_holder v_h =
             reinterpret_cast<instance*>(src.ptr())->get_value_and_holder(get_type_info(typeid(T)), false);
-        if (!v_h || !v_h.instance_registered())
+        if (v_h.vh == nullptr || !v_h.instance_registered())  // vh: found (its operator bool reads *vh)
             throw type_error(std::string(Py_TYPE(src.ptr())->tp_name) +
                              " object was made by __new__ without __init__: make it by calling the class");
         return true;

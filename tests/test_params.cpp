@@ -2,6 +2,9 @@
 // calls a default is one it accepts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <clocale>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -75,6 +78,49 @@ TEST(Params, DefaultsAreValidValuesAndTheBuildsDefaults) {
             EXPECT_EQ(sa.tree->sah_cost, sb.tree->sah_cost) << kind;
         }
     }
+}
+
+// Parameter numbers are written (the tables' defaults, the settings) and read in the C locale's form
+// whatever the process's locale: printf's "%.0f" and "%g" as the C locale writes them, and a build
+// with the defaults works under a locale whose decimal point is a comma (a caller's setlocale, as
+// Python's locale.setlocale or a C program's, once made every default unreadable).
+TEST(Params, NumbersAreWrittenAndReadAlikeInEveryLocale) {
+    for (const double v : {0.0, 1.0, 15.0, 45.0, 0.1, 0.05, 0.99, 1e-6, 1e6, 2.5e-3, 123456.7, 1e15, 1e20, -0.5}) {
+        char c_form[64];
+        if (v == std::floor(v) && std::fabs(v) < 1e15) std::snprintf(c_form, sizeof c_form, "%.0f", v);
+        else std::snprintf(c_form, sizeof c_form, "%g", v);
+        EXPECT_EQ(param_number(v), c_form);
+    }
+    // A number too small for a double is read as the nearest double (0 here), as strtod read it.
+    AccelConfig tiny = parse_accel_config("kd@empty_bonus=1e-400");
+    tiny.threads = 1;
+    EXPECT_NO_THROW(make_accelerator(small_scene(), tiny));
+    struct Restore {
+        std::string numeric = std::setlocale(LC_NUMERIC, nullptr);
+        ~Restore() { std::setlocale(LC_NUMERIC, numeric.c_str()); }
+    } restore;
+    bool comma = false;
+    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8", "nl_NL.UTF-8", "ru_RU.UTF-8"})
+        if (std::setlocale(LC_NUMERIC, name) && std::string(std::localeconv()->decimal_point) == ",") {
+            comma = true;
+            break;
+        }
+    if (!comma) GTEST_SKIP() << "no locale with a decimal comma is installed (localedef -i de_DE -f UTF-8 de_DE.UTF-8)";
+    EXPECT_EQ(param_number(0.1), "0.1");
+    EXPECT_EQ(param_number(1e-6), "1e-06");
+    for (const std::string kind : {"kd", "bih", "bvh", "auto"}) {
+        AccelConfig c;
+        c.kind = kind;
+        c.threads = 1;
+        for (const ParamSpec& p : accelerator_params(kind)) {
+            if (p.type == ParamType::number) c.params[p.name] = param_number(std::min(p.max, std::max(p.min, 0.25)));
+        }
+        EXPECT_NO_THROW(make_accelerator(small_scene(), c)) << kind;
+    }
+    AccelConfig comma_text;
+    comma_text.kind = "kd";
+    comma_text.params = {{"empty_bonus", "0,25"}};
+    EXPECT_THROW(make_accelerator(small_scene(), comma_text), Error);
 }
 
 // Unknown names, values beyond a range, and unknown kinds or traversals are refused everywhere, with

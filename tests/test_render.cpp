@@ -132,6 +132,18 @@ TEST(Render, ReadPfmRefusesWhatIsNotARegularFile) {
         out << "PF\n4 2\n-1\n" << std::string(12, '\0');
     }
     EXPECT_EQ(error_of(truncated), truncated + ": file is truncated");
+    // Headers that are not a little-endian RGB PFM's, a greyscale or big-endian one among them, and a
+    // file of no header at all, refused after at most 256 bytes of it.
+    const std::string other = (dir / "other.pfm").string();
+    const std::vector<std::string> headers{"Pf\n4 2\n-1\n", "PF\n4 2\n1\n", "PF\n4 x\n-1\n", "PF\n4 2\n",
+                                           "P6\n4 2\n255\n", std::string(100000, 'A')};
+    for (const std::string& header : headers) {
+        {
+            std::ofstream out(other, std::ios::binary | std::ios::trunc);
+            out << header << std::string(96, '\0');
+        }
+        EXPECT_EQ(error_of(other), other + ": not a little-endian RGB PFM file") << header.substr(0, 20);
+    }
     std::filesystem::remove_all(dir);
 }
 

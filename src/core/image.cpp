@@ -11,6 +11,7 @@
 
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
+#include "core/parse_number.hpp"
 #include "core/read_file.hpp"
 
 namespace cellrt {
@@ -127,25 +128,38 @@ void write_image(const Image& image, const std::string& path, bool overwrite) {
     write_file_atomically(path, bytes, overwrite);
 }
 
-// Read as the loaders read (core/read_file.hpp): only a regular file, so that a pipe or a device in
-// the image's place is refused rather than waited on.
+// Opened as the loaders open files (core/read_file.hpp): only a regular file, so that a pipe or a
+// device in the image's place is refused rather than waited on. The header is read as iostreams'
+// `>> magic >> width >> height >> scale` and one character after it, then the rows straight into
+// the image (bottom row first).
 Image read_pfm(const std::string& path) {
-    std::istringstream in(detail::read_file(path), std::ios::binary);
-    std::string magic;
+    detail::RegularFile file(path);
+    const Error not_pfm(path + ": not a little-endian RGB PFM file");
+    std::string tokens[4];
+    int read_tokens = 0;
+    for (std::size_t header = 0;; ++header) {
+        char c = 0;
+        if (header == 256 || file.read(&c, 1) == 0) throw not_pfm;
+        const bool space = c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\v' || c == '\f';
+        if (!space) tokens[read_tokens] += c;
+        else if (!tokens[read_tokens].empty() && ++read_tokens == 4) break;  // the character after the scale
+    }
     int w = 0, h = 0;
     double scale = 0.0;
-    in >> magic >> w >> h >> scale;
-    in.get();
-    if (!in || magic != "PF" || scale >= 0.0) throw Error(path + ": not a little-endian RGB PFM file");
+    using detail::ParsedNumber;
+    if (tokens[0] != "PF" || detail::parse_number(tokens[1], w) != ParsedNumber::Ok ||
+        detail::parse_number(tokens[2], h) != ParsedNumber::Ok ||
+        detail::parse_number(tokens[3], scale) != ParsedNumber::Ok || !(scale < 0.0))
+        throw not_pfm;
     try {
         check_image_size(w, h);
     } catch (const Error& e) {
         throw Error(path + ": " + e.what());
     }
     Image image(w, h);
+    const std::size_t row = sizeof(Vec3) * static_cast<std::size_t>(w);
     for (int y = h - 1; y >= 0; --y)
-        in.read(reinterpret_cast<char*>(&image.at(0, y)), static_cast<std::streamsize>(sizeof(Vec3)) * w);
-    if (!in) throw Error(path + ": file is truncated");
+        if (file.read(reinterpret_cast<char*>(&image.at(0, y)), row) != row) throw Error(path + ": file is truncated");
     return image;
 }
 

@@ -1,15 +1,20 @@
 #include "cellrt/params.hpp"
 
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 
 namespace cellrt {
 
+// Written by std::to_chars, as printf's "%.0f" and "%g" would write them in the C locale, whatever
+// the process's locale: the parameter reader reads these texts back (defaults included) with
+// std::from_chars, which knows no other decimal point (a "%g" under a locale writing "0,1" made
+// every default unreadable).
 std::string param_number(double v) {
     char buf[32];
-    if (v == std::floor(v) && std::fabs(v) < 1e15) std::snprintf(buf, sizeof buf, "%.0f", v);
-    else std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
+    const bool whole = v == std::floor(v) && std::fabs(v) < 1e15;
+    const auto result = whole ? std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 0)
+                              : std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6);
+    return std::string(buf, result.ptr);
 }
 
 namespace {

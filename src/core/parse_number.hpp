@@ -22,12 +22,14 @@ ParsedNumber parse_number(std::string_view tok, T& out) {
     if (ptr != end || tok.empty() || (ec != std::errc() && ec != std::errc::result_out_of_range))
         return ParsedNumber::Malformed;
     if (ec == std::errc()) return ParsedNumber::Ok;
-    if constexpr (std::is_same_v<T, float>) {
-        // Out of float's range: too large, or so small that it underflows (then take double's value).
-        double wide = 0.0;
+    if constexpr (std::is_floating_point_v<T>) {
+        // Out of the type's range: too large, or so small that it underflows (then take the value of
+        // a wider type, rounded).
+        using Wide = std::conditional_t<std::is_same_v<T, float>, double, long double>;
+        Wide wide = 0;
         if (std::from_chars(tok.data(), end, wide).ec == std::errc() &&
-            std::fabs(wide) <= std::numeric_limits<float>::max()) {
-            out = static_cast<float>(wide);
+            std::fabs(wide) <= std::numeric_limits<T>::max()) {
+            out = static_cast<T>(wide);
             return ParsedNumber::Ok;
         }
     }
