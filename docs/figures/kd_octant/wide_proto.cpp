@@ -232,5 +232,5 @@ int main(int argc, char** argv) {
         tr.push_back(std::chrono::duration<double>(t1 - t0).count()); tb.push_back(std::chrono::duration<double>(t2 - t1).count()); tw.push_back(std::chrono::duration<double>(t3 - t2).count());
     }
     std::sort(tr.begin(), tr.end()); std::sort(tb.begin(), tb.end()); std::sort(tw.begin(), tw.end());
-    std::printf("ns/ray rec %.1f branched %.1f wide %.1f  wide/rec %.3f\n", tr[3] / rays.size() * 1e9, tb[3] / rays.size() * 1e9, tw[3] / rays.size() * 1e9, tw[3] / tr[3]);
+    std::printf("ns/ray rec %.1f br2 %.1f wide %.1f  wide/rec %.3f\n", tr[3] / rays.size() * 1e9, tb[3] / rays.size() * 1e9, tw[3] / rays.size() * 1e9, tw[3] / tr[3]);
 }
