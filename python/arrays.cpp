@@ -19,6 +19,7 @@ py::array as_array(py::handle object, const std::string& name) {
     try {
         return numpy().attr("asarray")(object);
     } catch (py::error_already_set& e) {
+        if (e.matches(PyExc_MemoryError)) throw;  // running out of memory says nothing of the argument
         throw py::value_error(name + " is not an array: " + message_of(e));
     }
 }
@@ -36,6 +37,7 @@ py::array required(const py::array& a, const char* dtype, const std::string& nam
     try {
         return numpy().attr("require")(a, dtype, "CA");
     } catch (py::error_already_set& e) {
+        if (e.matches(PyExc_MemoryError)) throw;
         throw py::value_error(name + " cannot be converted to " + dtype + ": " + message_of(e));
     }
 }
@@ -178,7 +180,11 @@ unsigned small_count(py::handle object, const std::string& name, unsigned max) {
 std::string text(py::handle object, const std::string& name) {
     if (!py::isinstance<py::str>(object))
         throw py::value_error(name + " must be a str, got " + py::repr(object).cast<std::string>());
-    return object.cast<std::string>();
+    std::string s = object.cast<std::string>();
+    // The library's messages are C strings: a NUL would cut the name it is refused with.
+    if (s.find('\0') != std::string::npos)
+        throw py::value_error(name + " must not contain a NUL character, got " + py::repr(object).cast<std::string>());
+    return s;
 }
 
 }  // namespace cellrt::python

@@ -76,7 +76,7 @@ namespace cellrt::python {
 namespace {
 
 std::string param_value(py::handle value, const std::string& name) {
-    if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+    if (py::isinstance<py::str>(value)) return text(value, name);
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
     if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
     if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();

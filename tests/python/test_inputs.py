@@ -236,3 +236,26 @@ def test_an_unmade_object_is_refused_as_an_argument():
     made.camera.fov_y_deg = 40.0
     assert made.camera.fov_y_deg == 40.0
     assert made.light.position is not None
+
+
+def test_a_nul_in_a_name_is_refused_not_cut():
+    # The library's messages are C strings: "kd\0x" would have been refused as "kd".
+    refused("kind must not contain a NUL character", cellrt.Accelerator, TRI, kind="kd\0x")
+    refused("simd must not contain a NUL character", cellrt.Accelerator, TRI, simd="off\0")
+    refused(r"params\['leaf_size'\] must not contain a NUL character", cellrt.Accelerator, TRI, kind="kd",
+            params={"leaf_size": "4\0"})
+    refused("a key of params must not contain a NUL character", cellrt.Accelerator, TRI, kind="kd",
+            params={"leaf\0size": 4})
+
+
+class _OutOfMemory:
+    def __array__(self, dtype=None, copy=None):
+        raise MemoryError("no room")
+
+
+def test_running_out_of_memory_while_converting_is_a_memory_error():
+    with pytest.raises(MemoryError):
+        cellrt.Accelerator(_OutOfMemory())
+    acc = cellrt.Accelerator(TRI)
+    with pytest.raises(MemoryError):
+        acc.intersect(_OutOfMemory(), D)
