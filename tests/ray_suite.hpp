@@ -3,7 +3,7 @@
 // random rays from outside and inside the scene, axis-parallel rays with +0 and -0 components,
 // rays aimed exactly at vertices, at edge points and at axis planes through vertices (where split
 // planes lie), rays whose tfar ends exactly at or just before the reference hit, rays with
-// tnear > 0, and invalid rays (NaN, infinite, zero direction, tnear > tfar).
+// tnear > 0, and invalid rays (NaN, infinite, zero or subnormal direction, tnear > tfar, tnear = +inf).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -158,6 +158,7 @@ private:
         add({nan, c.y, c.z}, {1.f, 0.f, 0.f});
         add(c, {nan, 0.f, 1.f});
         add(c, {0.f, 0.f, 0.f});
+        add(c, {0.f, 0.f, -1e-40f});  // subnormal
         add({kInfinity, 0.f, 0.f}, {-1.f, 0.f, 0.f});
         add(c, {kInfinity, 1.f, 0.f});
         Ray r;
@@ -168,6 +169,8 @@ private:
         rays_.push_back(r);
         r.tnear = nan;
         r.tfar = kInfinity;
+        rays_.push_back(r);
+        r.tnear = kInfinity;  // [inf, inf]: no distance
         rays_.push_back(r);
     }
     void add(const Vec3& org, const Vec3& dir) {

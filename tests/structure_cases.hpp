@@ -39,6 +39,19 @@ inline RaySuiteOptions small_suite() {
     return o;
 }
 
+// 300 small random triangles (sides up to 0.2) in the unit cube at (3, 0, -2), all scaled by `scale`:
+// off the origin by a few times its size, so that the distances from rays to it grow with the scale.
+inline std::vector<Triangle> soup(float scale) {
+    std::uint32_t state = 777;
+    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    std::vector<Triangle> out;
+    for (int i = 0; i < 300; ++i) {
+        const Vec3 c = Vec3{next() + 3.f, next(), next() - 2.f}, e = Vec3{next(), next(), next()} * 0.2f;
+        out.push_back({c * scale, (c + Vec3{e.x, 0.f, e.z}) * scale, (c + Vec3{0.f, e.y, e.x}) * scale});
+    }
+    return out;
+}
+
 inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_scenes() {
     std::vector<std::pair<std::string, std::vector<Triangle>>> out;
     const Triangle unit{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
@@ -82,6 +95,13 @@ inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_sce
         huge.push_back({f, f + Vec3{1e11f, next() * 1e10f, 0.f}, f + Vec3{0.f, 1e11f, 1e11f}});
     }
     out.push_back({"huge coordinate range", huge});
+
+    // Scenes whose lengths squared leave a float's range (traversal_margin's second branch), seen
+    // along unit directions: at 1e20 the margin was inf / inf, NaN, and every structure culled the
+    // whole scene; at 1e-17 the watertight test's T underflows to garbage t that the margin's
+    // floor must cover. The hits there are few and meaningless, but every path must agree.
+    out.push_back({"soup at 1e20", soup(1e20f)});
+    out.push_back({"soup at 1e-17", soup(1e-17f)});
     return out;
 }
 

@@ -49,10 +49,10 @@ TEST(Sanitizers, SuiteSampleKeepsEveryKindOfRay) {
                                                  test::small_suite()).rays();
     const std::vector<Ray> sample = test::sanitized_sample(rays, stride);
     const auto invalid = [](const std::vector<Ray>& rs) { return std::ranges::count_if(rs, test::is_invalid); };
-    EXPECT_EQ(invalid(rays), 7);
-    EXPECT_EQ(invalid(sample), 7);
+    EXPECT_EQ(invalid(rays), 10);
+    EXPECT_EQ(invalid(sample), 10);
     EXPECT_GE(sample.size(), rays.size() / stride);
-    EXPECT_LE(sample.size(), rays.size() / stride + 1 + 7);
+    EXPECT_LE(sample.size(), rays.size() / stride + 1 + 10);
     // The axis-parallel directions: axis, sign, and the signs of the two zero components.
     using Kind = std::tuple<int, bool, bool, bool>;
     const auto axis_kinds = [](const std::vector<Ray>& rs) {

@@ -75,6 +75,52 @@ TEST_P(DegenerateInputs, SameHits) {
 INSTANTIATE_TEST_SUITE_P(Structures, DegenerateInputs, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
 
+// A scene and its rays scaled by a power of two, vertices, origins and directions alike: every step
+// of the watertight test scales exactly, so brute force finds the unscaled hits (triangle and t; the
+// barycentrics can differ where an edge function leaves the normal range), and every structure must
+// give brute force's answers. At 2^62 the squared distances from the rays to the scene overflow a
+// float while its triangles' edge functions do not: the margin was inf / inf, NaN, and every
+// structure culled the whole scene (fuzz_gltf found a glTF scene at 8.4e18). At 2^-52 the squared
+// distances lie below 2^-100, traversal_margin's second branch.
+class ScaledByPowersOfTwo : public testing::TestWithParam<std::string> {};
+
+TEST_P(ScaledByPowersOfTwo, SameHits) {
+    struct Case {
+        int exponent;
+        std::vector<Triangle> tris;
+        test::ReferenceAnswers ref;
+    };
+    static const auto [base, cases] = [] {
+        const std::vector<Triangle> tris = test::soup(1.f);
+        test::ReferenceAnswers unscaled =
+            test::compute_reference(tris, test::RaySuite(tris, test::small_suite()).rays());
+        std::vector<Case> out;
+        for (const int e : {62, -52}) {
+            const float s = std::ldexp(1.f, e);
+            std::vector<Ray> rays = unscaled.rays;
+            for (Ray& r : rays) r.org = r.org * s, r.dir = r.dir * s;
+            std::vector<Triangle> scaled = test::soup(s);
+            test::ReferenceAnswers ref = test::compute_reference(scaled, std::move(rays));
+            out.push_back({e, std::move(scaled), std::move(ref)});
+        }
+        return std::pair{std::move(unscaled), std::move(out)};
+    }();
+    for (const Case& c : cases) {
+        const std::string what = GetParam() + " on a soup scaled by 2^" + std::to_string(c.exponent);
+        std::size_t differ = 0, hits = 0;
+        for (std::size_t i = 0; i < base.hits.size(); ++i) {
+            differ += c.ref.hits[i].prim != base.hits[i].prim || !(c.ref.hits[i].t == base.hits[i].t);
+            hits += base.hits[i].is_hit();
+        }
+        ASSERT_GT(hits, base.hits.size() / 10) << "the suite must meet the scene";
+        EXPECT_LE(differ, base.hits.size() / 1000) << "brute force, " << what << ", against the unscaled soup";
+        test::expect_matches(*make_accelerator(c.tris, parse_accel_config(GetParam())), c.ref, what);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, ScaledByPowersOfTwo, testing::ValuesIn(kConfigs),
+                         [](const auto& info) { return name_of(info.param); });
+
 // The packet kernels on the rays they are made for: a frame's primary rays in square tiles and the
 // shadow rays of their hits, in batches of 8 x 8 and 16 x 16 (entry-point search) and of sizes that
 // leave the last packet partly empty.
@@ -280,9 +326,11 @@ std::vector<Ray> invalid_rays(const Scene& scene) {
         }
     breaks.push_back([](Ray& r) { r.dir = Vec3{}; });
     breaks.push_back([](Ray& r) { r.dir = Vec3{-0.f, -0.f, -0.f}; });
+    breaks.push_back([](Ray& r) { r.dir = Vec3{1e-40f, -1e-45f, 0.f}; });  // subnormal: no 1 / d
     breaks.push_back([=](Ray& r) { r.tnear = nan; });
     breaks.push_back([=](Ray& r) { r.tfar = nan; });
     breaks.push_back([](Ray& r) { r.tnear = 2.f, r.tfar = 1.f; });
+    breaks.push_back([](Ray& r) { r.tnear = kInfinity; });  // [inf, inf]
     std::vector<Ray> out;
     for (const auto& b : breaks) {
         out.push_back(aimed);

@@ -137,8 +137,29 @@ TEST(Watertight, InvalidRaysHitNothing) {
                          Ray{{0.f, 0.f, 1.f}, 0.f, {nan, 0.f, -1.f}, kInfinity},
                          Ray{{nan, 0.f, 1.f}, 0.f, {0.f, 0.f, -1.f}, kInfinity},
                          Ray{{0.f, 0.f, 1.f}, 2.f, {0.f, 0.f, -1.f}, 1.f},
-                         Ray{{0.f, 0.f, 1.f}, nan, {0.f, 0.f, -1.f}, kInfinity}})
+                         Ray{{0.f, 0.f, 1.f}, nan, {0.f, 0.f, -1.f}, kInfinity},
+                         Ray{{0.f, 0.f, 1.f}, kInfinity, {0.f, 0.f, -1.f}, kInfinity},
+                         Ray{{0.f, 0.f, 1.f}, 0.f, {0.f, 0.f, -1e-40f}, kInfinity}})
         EXPECT_FALSE(closest(std::span(&tri, 1), r).is_hit());
+}
+
+// Where the test's arithmetic leaves a float's range (docs/HIT_SEMANTICS.md, "Known limits"): a
+// determinant that overflows (edge functions of 1e40) or is subnormal (1e-40) is no hit, where it
+// used to be a hit at t = 0 (1 / inf) or at a t of rounding noise; a t that overflows (T of 1e39
+// over a det of 1e26) is a hit at t = inf, and no other structure path sees it otherwise.
+TEST(Watertight, ArithmeticBeyondTheFloatRange) {
+    const Ray down{{0.f, 0.f, 1.f}, 0.f, {0.f, 0.f, -1.f}, kInfinity};
+    for (const float size : {1e20f, 1e-20f}) {
+        const Triangle tri{{-size, -size, 0.f}, {size, -size, 0.f}, {0.f, size, 0.f}};
+        EXPECT_FALSE(closest(std::span(&tri, 1), down).is_hit()) << "a triangle of size " << size;
+    }
+    const Triangle ordinary{{-1.f, -1.f, 0.f}, {1.f, -1.f, 0.f}, {0.f, 1.f, 0.f}};
+    EXPECT_EQ(closest(std::span(&ordinary, 1), down).t, 1.f);
+    const float far = 1e13f;
+    const Triangle distant{{-far, -far, -far}, {far, -far, -far}, {0.f, far, -far}};
+    const Hit h = closest(std::span(&distant, 1), down);
+    EXPECT_TRUE(h.is_hit());
+    EXPECT_EQ(h.t, kInfinity);
 }
 
 // The SSE2 test (three vertices in three lanes) against the scalar one it replaces on x86-64: the

@@ -62,8 +62,9 @@ typedef struct cellrt_accel_handle* cellrt_accel;
 typedef void (*cellrt_error_function)(void* user, cellrt_error code, const char* message);
 
 /* A ray as one struct: origin, tnear, direction, tfar (32 bytes). Under the hit rule a hit has
- * tnear <= t <= tfar; a ray with a non-finite or zero direction, a non-finite origin, a NaN bound or
- * tnear > tfar hits nothing (docs/HIT_SEMANTICS.md). */
+ * tnear <= t <= tfar; a ray with a non-finite or zero direction (or one whose components are all
+ * subnormal), a non-finite origin, a NaN bound, tnear > tfar or tnear = +inf hits nothing
+ * (docs/HIT_SEMANTICS.md). */
 typedef struct cellrt_ray {
     float org_x, org_y, org_z, tnear;
     float dir_x, dir_y, dir_z, tfar;

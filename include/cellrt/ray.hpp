@@ -3,11 +3,13 @@
 // Hit rule (docs/HIT_SEMANTICS.md): the hit of a ray is the triangle with the smallest t such that
 // tnear <= t <= tfar, where t is the value the watertight test (triangle.hpp) computes; among
 // triangles with equal t the lowest index wins. Any-hit (occlusion) asks only whether such a
-// triangle exists. A ray with a non-finite or zero direction, a non-finite origin, a NaN bound or
-// tnear > tfar hits nothing. Because the rule names one triangle, the image never depends on the
-// structure or on the order in which a traversal visits its nodes.
+// triangle exists. A ray with a non-finite or zero direction (or one whose components are all
+// subnormal, below 2^-126: the watertight test divides by the largest), a non-finite origin, a NaN
+// bound, tnear > tfar or tnear = +inf hits nothing. Because the rule names one triangle, the image
+// never depends on the structure or on the order in which a traversal visits its nodes.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -43,8 +45,10 @@ CELLRT_HD inline bool closer(float t, std::uint32_t prim, const Hit& best) {
 }
 
 [[gnu::always_inline]] CELLRT_HD inline bool is_valid(const Ray& r) {
-    return is_finite(r.org) && is_finite(r.dir) && !(r.dir == Vec3{}) && !(r.tnear > r.tfar) &&
-           r.tnear == r.tnear && r.tfar == r.tfar;
+    constexpr float kLeast = 0x1p-126f;  // the least normal float
+    return is_finite(r.org) && is_finite(r.dir) &&
+           (std::fabs(r.dir.x) >= kLeast || std::fabs(r.dir.y) >= kLeast || std::fabs(r.dir.z) >= kLeast) &&
+           !(r.tnear > r.tfar) && r.tnear < kInfinity && r.tfar == r.tfar;
 }
 
 // The initial best of a closest-hit query: nothing found, any t up to tfar still admissible.

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -63,11 +64,22 @@ struct WatertightRay {
     }
 };
 
+// Whether the test's determinant is a normal float, neither zero, subnormal nor infinite (NaN fails).
+CELLRT_HD inline bool det_in_range(float det) {
+    const float a = std::fabs(det);
+    return a >= 0x1p-126f && a < kInfinity;
+}
+
 // Core of the test: on success writes t = T/det and the barycentrics, without any range check.
 // Returns false when the ray misses the triangle's plane region or the triangle is degenerate
-// (det == 0: zero area, or seen edge-on). Always inlined, as the per-ray set-up of the traversals
-// (kernel/traversal.hpp): a unit that instantiates many kernels exhausts GCC's inlining budget,
-// and an out-of-line call costs a kernel up to a tenth of its instructions (docs/BENCHMARKS.md).
+// (det == 0: zero area, or seen edge-on), and where det is not a normal float: the edge functions'
+// products over- or underflowed (vertices some 1e19 or 1e-19 from the ray in the sheared space), and
+// t = T / det would be 0 or garbage that no structure's interval reaches (docs/HIT_SEMANTICS.md,
+// "Known limits"). t itself can overflow (T grows as the cube of the distance: some 1e13 away
+// along a unit direction): such a hit is at t = inf, as on every path. Always inlined, as the
+// per-ray set-up of the traversals (kernel/traversal.hpp): a unit that instantiates many kernels
+// exhausts GCC's inlining budget, and an out-of-line call costs a kernel up to a tenth of its
+// instructions (docs/BENCHMARKS.md).
 [[gnu::always_inline]] CELLRT_HD inline bool intersect_unbounded_scalar(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     // The vertices' coordinates in ray order (x, y, z of v0, v1, v2: the nine floats of the
     // triangle's storage, read in place by index as Vec3::operator[] reads three).
@@ -87,7 +99,7 @@ struct WatertightRay {
     }
     if ((eu < 0.f || ev < 0.f || ew < 0.f) && (eu > 0.f || ev > 0.f || ew > 0.f)) return false;
     const float det = eu + ev + ew;
-    if (det == 0.f) return false;
+    if (!det_in_range(det)) return false;
     const float az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
     const float big_t = eu * az + ev * bz + ew * cz;
     const float inv_det = 1.f / det;
@@ -127,8 +139,9 @@ struct WatertightRay {
         return false;
     const float eu = _mm_cvtss_f32(e), ev = _mm_cvtss_f32(_mm_shuffle_ps(e, e, 1)), ew = _mm_cvtss_f32(_mm_movehl_ps(e, e));
     // Three non-zero edges of one sign: their sum is not zero (the scalar test's det == 0 case
-    // needs a zero edge, which went to it above).
+    // needs a zero edge, which went to it above), but it may leave the normal range.
     const float det = eu + ev + ew;
+    if (!det_in_range(det)) return false;
     const __m128 p = _mm_mul_ps(e, _mm_mul_ps(_mm_set1_ps(r.sz), dz));  // eu az, ev bz, ew cz
     const float big_t = (_mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1))) + _mm_cvtss_f32(_mm_movehl_ps(p, p));
     const float inv_det = 1.f / det;

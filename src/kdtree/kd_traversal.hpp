@@ -196,12 +196,12 @@ struct KdRecKernel {
     template <class Tree, class Memory, class Query, class Counters>
     CELLRT_HD bool operator()(const Tree& tree, Memory& mem, const TraversalRay& r, Query& q, Counters& c) const {
         // Where the direction's length squared under- or overflows (components below 1e-19 or above
-        // 1e19), the margin is infinite or zero and TA_rec's coordinate tolerance, margin times that
-        // length, is 0 * inf: no bound on its points' coordinates is known. Such a ray takes the
+        // 1e19), or the margin is infinite, TA_rec's coordinate tolerance, the margin times that
+        // length, is 0 or inf: no bound on its points' coordinates is known. Such a ray takes the
         // interval traversal, whose tests are on t alone (checked here, so that TA_rec's own code,
         // the study's, stays as it was).
         const float reach = r.margin * length(r.dir);
-        if (!(reach == reach)) return traverse_branched<KdTraits>(tree, mem, r, q, c);
+        if (!(reach > 0.f && reach < kInfinity)) return traverse_branched<KdTraits>(tree, mem, r, q, c);
         return kd_traverse_rec(tree, mem, r, q, c);
     }
 };

@@ -32,6 +32,42 @@ inline constexpr float kMarginScale = 1.f / 65536.f;
 CELLRT_HD inline float min_keep(float kept, float x) { return x < kept ? x : kept; }
 CELLRT_HD inline float max_keep(float kept, float x) { return x > kept ? x : kept; }
 
+// The least margin, an absolute error of t that the relative margin does not cover. Where the
+// watertight test's T is subnormal (triangles near 1e-13 and below from the origin along a unit
+// direction; T grows as their distance cubed), it is exact only to about 2^-149, and t = T / det,
+// det at least 2^-126 (det_in_range), to about 2^-21.5; this keeps four times that. It only acts
+// where the whole scene lies within t < 2^-4 of the origin: for ordinary scenes and directions
+// the relative margin is larger (a 1e-17 scene along unit directions had garbage t of 0 that
+// brute force ranked first and the structures culled).
+inline constexpr float kMarginFloor = 0x1p-20f;
+
+// The margin in t: kMarginScale times the largest distance from the origin to the scene box
+// (`reach`, per axis), over the direction's length, and at least kMarginFloor. Taken directly, the
+// lengths' squares over- or underflow where components pass about 1e19 or fall below 1e-19 (scenes
+// of such coordinates, directions of such lengths): inf / inf or 0 / 0 gave a NaN margin that culled
+// every cell (a glTF scene at 8.4e18, found by fuzz_gltf), and finite / inf a margin of 0. A result
+// that is not positive and finite is therefore taken again with both vectors divided by their
+// largest component, out of line and with its arguments by value, so that ordinary rays pay only
+// the test (1 % of a kd-tree's camera ray's instructions on the bunny, callgrind). A square that
+// underflows into the subnormals keeps a few bits, enough for a margin, whose slack over the
+// errors it covers is 2^8.
+CELLRT_HD inline float at_least_floor(float margin) { return margin < kMarginFloor ? kMarginFloor : margin; }
+[[gnu::noinline]] CELLRT_NOINLINE CELLRT_HD inline float traversal_margin_rescaled(Vec3 reach, Vec3 dir) {
+    const Vec3 d = abs(dir);
+    const float rm = std::max(reach.x, std::max(reach.y, reach.z)), dm = std::max(d.x, std::max(d.y, d.z));
+    if (rm == kInfinity || dm == 0.f) return kInfinity;  // the box's distance overflowed, or no direction
+    if (rm == 0.f) return kMarginFloor;                  // the box is one point, the origin
+    // Lengths of vectors with a largest component of 1: within [1, sqrt 3], exact to a few ulps.
+    return at_least_floor(kMarginScale * (length(reach / rm) / length(d / dm)) * (rm / dm));
+}
+// Whether a margin taken directly can stand: positive and finite (NaN fails).
+CELLRT_HD inline bool direct_margin_holds(float m) { return m > 0.f && m < kInfinity; }
+[[gnu::always_inline]] CELLRT_HD inline float traversal_margin(const Vec3& reach, const Vec3& dir) {
+    const float m = kMarginScale * length(reach) / length(dir);
+    if (direct_margin_holds(m)) [[likely]] return at_least_floor(m);
+    return traversal_margin_rescaled(reach, dir);
+}
+
 struct TraversalRay {
     Vec3 org, dir, inv_dir;
     std::uint32_t dir_neg[3];  // 1 where the direction's sign bit is set (-0 included): the near child index
@@ -46,8 +82,7 @@ struct TraversalRay {
             inv_dir[a] = 1.f / dir[a];
             dir_neg[a] = std::signbit(dir[a]) ? 1u : 0u;
         }
-        const Vec3 reach = max(abs(scene_box.lo - org), abs(scene_box.hi - org));
-        margin = kMarginScale * length(reach) / length(dir);
+        margin = traversal_margin(max(abs(scene_box.lo - org), abs(scene_box.hi - org)), dir);
     }
 
     CELLRT_HD Vec3 at(float t) const { return org + dir * t; }

@@ -33,11 +33,12 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
         loaded[i] = -1;
     }
     // is_valid (ray.hpp): finite origin and direction (x - x is 0 only for finite x), a direction
-    // that is not zero, tnear <= tfar, no NaN bound.
+    // with a component of at least 2^-126, tnear <= tfar, no NaN bound, tnear below +inf.
     I finite = loaded;
     for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
-    L.valid = finite & ~((d[0] == 0.f) & (d[1] == 0.f) & (d[2] == 0.f)) & ~(L.tnear > L.tfar) &
-              (L.tnear == L.tnear) & (L.tfar == L.tfar);
+    const F least = splat(0x1p-126f);
+    const I normal_dir = (abs_lanes(d[0]) >= least) | (abs_lanes(d[1]) >= least) | (abs_lanes(d[2]) >= least);
+    L.valid = finite & normal_dir & ~(L.tnear > L.tfar) & (L.tnear < splat(kInfinity)) & (L.tfar == L.tfar);
     F reach[3];
     for (int a = 0; a < 3; ++a) {
         L.org[a] = select(L.valid, o[a], splat(0.f));
@@ -48,7 +49,15 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     }
     const F reach_length = sqrt_lanes(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]);
     const F dir_length = sqrt_lanes(L.dir[0] * L.dir[0] + L.dir[1] * L.dir[1] + L.dir[2] * L.dir[2]);
-    L.margin = splat(kMarginScale) * reach_length / dir_length;
+    const F m = splat(kMarginScale) * reach_length / dir_length;
+    L.margin = max_lanes(m, splat(kMarginFloor));
+    // traversal_margin, lane by lane: where the direct margin does not hold, the rescaled one.
+    const I direct = (m > splat(0.f)) & (m < splat(kInfinity));
+    if (any(~direct))
+        for (std::size_t i = 0; i < kLanes; ++i)
+            if (!direct[i])
+                L.margin[i] = traversal_margin_rescaled({reach[0][i], reach[1][i], reach[2][i]},
+                                                        {L.dir[0][i], L.dir[1][i], L.dir[2][i]});
     return L;
 }
 

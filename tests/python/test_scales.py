@@ -1,0 +1,60 @@
+"""Rays at lengths far from 1 (docs/HIT_SEMANTICS.md, "Known limits"): every structure, traversal
+and SIMD setting gives brute force's answers bit for bit when the directions, or the origins and
+directions together, are scaled from subnormal lengths to near FLT_MAX. Where the float test leaves
+its range a triangle is a miss on every path, never a hit that one path finds and another culls."""
+import numpy as np
+import pytest
+
+import cellrt
+
+KINDS = ["kd:branched", "kd:rec", "kd:branchless", "bih:branched", "bih:branchless",
+         "bvh", "bvh:paired", "bvh:stream", "bvh:packet", "auto"]
+
+
+@pytest.fixture(scope="module")
+def probe():
+    tris = np.asarray(cellrt.load_scene("builtin:spheres?tris=2000").triangles, dtype=np.float32)
+    points = tris.reshape(-1, 3)
+    lo, hi = points.min(0), points.max(0)
+    rng = np.random.default_rng(5)
+    n = 1200
+    org = (lo + (hi - lo) * rng.uniform(-0.5, 1.5, size=(n, 3))).astype(np.float32)
+    dirs = rng.uniform(-1, 1, size=(n, 3)).astype(np.float32)
+    along = np.arange(n) % 4 == 1  # a quarter along an axis, either way
+    dirs[along] = 0
+    dirs[along, (np.arange(n)[along] // 4) % 3] = np.where(np.arange(n)[along] % 8 < 4, 1, -1)
+    return tris, org, dirs
+
+
+def disagreements(tris, org, dirs):
+    ref = cellrt.Accelerator(tris, kind="brute", simd="off").intersect(org, dirs)
+    bad = []
+    for kind in KINDS:
+        for simd in ("off", "auto"):
+            got = cellrt.Accelerator(tris, kind=kind, simd=simd).intersect(org, dirs)
+            differ = (got["prim"] != ref["prim"]) | (got["t"].view(np.uint32) != ref["t"].view(np.uint32))
+            if differ.any():
+                bad.append(f"{kind} simd={simd}: {int(differ.sum())} rays")
+    return ref, bad
+
+
+@pytest.mark.parametrize("scale", [1e-45, 1e-40, 1e-30, 1e-20, 1e17, 1e19, 1e20, 1e25, 1e30, 3e38])
+def test_scaled_directions(probe, scale):
+    tris, org, dirs = probe
+    ref, bad = disagreements(tris, org, (dirs * np.float32(scale)).astype(np.float32))
+    assert not bad, bad
+    # Subnormal directions hit nothing (ray.hpp); the others meet the triangles the unscaled ones do.
+    unscaled = cellrt.Accelerator(tris, kind="brute", simd="off").intersect(org, dirs)
+    if scale < 1e-38:
+        assert (ref["prim"] < 0).all()
+    else:
+        assert (unscaled["prim"] >= 0).sum() > len(org) // 10
+        assert (ref["prim"] >= 0).sum() == (unscaled["prim"] >= 0).sum()
+
+
+@pytest.mark.parametrize("scale", [1e15, 1e20, 1e30])
+def test_scaled_origins_and_directions(probe, scale):
+    tris, org, dirs = probe
+    s = np.float32(scale)
+    _, bad = disagreements(tris, (org * s).astype(np.float32), (dirs * s).astype(np.float32))
+    assert not bad, bad
