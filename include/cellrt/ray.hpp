@@ -20,6 +20,7 @@ namespace cellrt {
 
 inline constexpr std::uint32_t kNoHit = std::numeric_limits<std::uint32_t>::max();
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+inline constexpr float kLargestFloat = std::numeric_limits<float>::max();
 
 struct Ray {
     Vec3 org;

@@ -72,11 +72,12 @@ CELLRT_HD inline bool det_in_range(float det) {
 
 // Core of the test: on success writes t = T/det and the barycentrics, without any range check.
 // Returns false when the ray misses the triangle's plane region or the triangle is degenerate
-// (det == 0: zero area, or seen edge-on), and where det is not a normal float: the edge functions'
-// products over- or underflowed (vertices some 1e19 or 1e-19 from the ray in the sheared space), and
-// t = T / det would be 0 or garbage that no structure's interval reaches (docs/HIT_SEMANTICS.md,
-// "Known limits"). t itself can overflow (T grows as the cube of the distance: some 1e13 away
-// along a unit direction): such a hit is at t = inf, as on every path. Always inlined, as the
+// (det == 0: zero area, or seen edge-on), and where the float arithmetic left its range: det not a
+// normal float (the edge functions' products over- or underflowed: vertices some 1e19 or 1e-19 from
+// the ray in the sheared space), or t not finite (T grows as the cube of the distance, and
+// overflows some 1e13 away along a unit direction). t there is 0, noise or inf, which no
+// structure's interval reaches (an interval from tnear past the scene box, say, culls what brute
+// force would take): docs/HIT_SEMANTICS.md, "Known limits". Always inlined, as the
 // per-ray set-up of the traversals (kernel/traversal.hpp): a unit that instantiates many kernels
 // exhausts GCC's inlining budget, and an out-of-line call costs a kernel up to a tenth of its
 // instructions (docs/BENCHMARKS.md).
@@ -106,7 +107,7 @@ CELLRT_HD inline bool det_in_range(float det) {
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return true;
+    return std::fabs(t) < kInfinity;
 }
 
 #if defined(CELLRT_SSE2_TRIANGLE)
@@ -148,7 +149,7 @@ CELLRT_HD inline bool det_in_range(float det) {
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return true;
+    return std::fabs(t) < kInfinity;
 }
 #endif
 

@@ -42,23 +42,26 @@ CELLRT_HD inline float max_keep(float kept, float x) { return x > kept ? x : kep
 inline constexpr float kMarginFloor = 0x1p-20f;
 
 // The margin in t: kMarginScale times the largest distance from the origin to the scene box
-// (`reach`, per axis), over the direction's length, and at least kMarginFloor. Taken directly, the
-// lengths' squares over- or underflow where components pass about 1e19 or fall below 1e-19 (scenes
-// of such coordinates, directions of such lengths): inf / inf or 0 / 0 gave a NaN margin that culled
-// every cell (a glTF scene at 8.4e18, found by fuzz_gltf), and finite / inf a margin of 0. A result
-// that is not positive and finite is therefore taken again with both vectors divided by their
-// largest component, out of line and with its arguments by value, so that ordinary rays pay only
-// the test (1 % of a kd-tree's camera ray's instructions on the bunny, callgrind). A square that
-// underflows into the subnormals keeps a few bits, enough for a margin, whose slack over the
-// errors it covers is 2^8.
+// (`reach`, per axis), over the direction's length, at least kMarginFloor and at most FLT_MAX.
+// Taken directly, the lengths' squares overflow where components pass about 1e19 and underflow to
+// 0 below about 1e-23 (scenes of such coordinates, directions of such lengths): inf / inf or 0 / 0
+// gave a NaN margin that culled every cell (a glTF scene at 8.4e18, found by fuzz_gltf), and
+// finite / inf a margin of 0. A result that is not positive and finite is therefore taken again
+// with both vectors divided by their largest component, out of line and with its arguments by
+// value, so that ordinary rays pay only the test (1 % of a kd-tree's camera ray's instructions on
+// the bunny, callgrind). A square that underflows into the subnormals keeps a few bits, enough
+// for a margin, whose slack over the errors it covers is 2^8.
 CELLRT_HD inline float at_least_floor(float margin) { return margin < kMarginFloor ? kMarginFloor : margin; }
 [[gnu::noinline]] CELLRT_NOINLINE CELLRT_HD inline float traversal_margin_rescaled(Vec3 reach, Vec3 dir) {
     const Vec3 d = abs(dir);
     const float rm = std::max(reach.x, std::max(reach.y, reach.z)), dm = std::max(d.x, std::max(d.y, d.z));
-    if (rm == kInfinity || dm == 0.f) return kInfinity;  // the box's distance overflowed, or no direction
-    if (rm == 0.f) return kMarginFloor;                  // the box is one point, the origin
+    // No bound, but a finite one: a margin of inf made inf - inf = NaN of an entry distance that
+    // overflowed, and the BVH's box test does not meet a NaN entry.
+    if (rm == kInfinity || dm == 0.f) return kLargestFloat;  // the box's distance overflowed, or no direction
+    if (rm == 0.f) return kMarginFloor;                      // the box is one point, the origin
     // Lengths of vectors with a largest component of 1: within [1, sqrt 3], exact to a few ulps.
-    return at_least_floor(kMarginScale * (length(reach / rm) / length(d / dm)) * (rm / dm));
+    const float m = kMarginScale * (length(reach / rm) / length(d / dm)) * (rm / dm);
+    return m < kLargestFloat ? at_least_floor(m) : kLargestFloat;
 }
 // Whether a margin taken directly can stand: positive and finite (NaN fails).
 CELLRT_HD inline bool direct_margin_holds(float m) { return m > 0.f && m < kInfinity; }

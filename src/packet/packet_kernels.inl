@@ -128,7 +128,7 @@ inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask,
     const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
-    const F abs_det = abs_lanes(det);  // det_in_range (triangle.hpp)
+    const F abs_det = abs_lanes(det);  // det_in_range (triangle.hpp); t's finiteness: the callers' bounds
     const F az = L.sz * a_kz, bz = L.sz * b_kz, cz = L.sz * c_kz;
     const F big_t = eu * az + ev * bz + ew * cz;
     const F inv_det = splat(1.f) / det;

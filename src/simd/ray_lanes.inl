@@ -11,7 +11,7 @@
 inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }  // std::fabs clears the sign bit
 inline F max_lanes(F a, F b) { return select(a < b, b, a); }        // std::max's choice, lane by lane
 
-// TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes). Lanes of invalid rays (ray.hpp) and
+// TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the finite floats. Lanes of invalid rays (ray.hpp) and
 // lanes past n hold a harmless ray (origin 0, direction (1, 1, 1)) and are not in `valid`.
 struct RayLanes {
     F org[3], dir[3], inv[3];
@@ -39,6 +39,10 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     const F least = splat(0x1p-126f);
     const I normal_dir = (abs_lanes(d[0]) >= least) | (abs_lanes(d[1]) >= least) | (abs_lanes(d[2]) >= least);
     L.valid = finite & normal_dir & ~(L.tnear > L.tfar) & (L.tnear < splat(kInfinity)) & (L.tfar == L.tfar);
+    // The bounds within the finite floats: a hit's t is finite (triangle.hpp), and the packets'
+    // triangle test leaves that to these bounds rather than testing each lane's t.
+    L.tnear = max_lanes(L.tnear, splat(-kLargestFloat));
+    L.tfar = select(L.tfar > splat(kLargestFloat), splat(kLargestFloat), L.tfar);
     F reach[3];
     for (int a = 0; a < 3; ++a) {
         L.org[a] = select(L.valid, o[a], splat(0.f));
