@@ -104,7 +104,8 @@ TEST(KdTree, DirectionComponentsNearTheLeastNormal) {
     std::size_t hits = 0;
     for (const Hit& h : ref.hits) hits += h.is_hit();
     ASSERT_GT(hits, rays.size() / 20);
-    for (const std::string& t : kTraversals) test::expect_matches(*make_accelerator(scene.triangles, kd(t)), ref, "kd " + t);
+    for (const std::string& t : kTraversals)
+        test::expect_matches(*make_accelerator(scene.triangles, kd(t)), ref, "kd " + t);
 }
 
 // Rays in, on and across the tree's own split planes: the places where a kd-tree decides which

@@ -11,8 +11,9 @@
 inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }  // std::fabs clears the sign bit
 inline F max_lanes(F a, F b) { return select(a < b, b, a); }        // std::max's choice, lane by lane
 
-// TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the finite floats. Lanes of invalid rays (ray.hpp) and
-// lanes past n hold a harmless ray (origin 0, direction (1, 1, 1)) and are not in `valid`.
+// TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the
+// finite floats. Lanes of invalid rays (ray.hpp) and lanes past n hold a harmless ray (origin 0,
+// direction (1, 1, 1)) and are not in `valid`.
 struct RayLanes {
     F org[3], dir[3], inv[3];
     I negative[3];  // the direction's sign bit per axis, -0 included (std::signbit): enters by the hi plane

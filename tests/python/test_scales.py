@@ -1,7 +1,8 @@
 """Rays at lengths far from 1 (docs/HIT_SEMANTICS.md, "Known limits"): every structure, traversal
 and SIMD setting gives brute force's answers bit for bit when the directions are scaled from
-subnormal lengths to near FLT_MAX, or the scene, origins and directions together from 1e-15 to 1e30. Where the float test leaves
-its range a triangle is a miss on every path, never a hit that one path finds and another culls."""
+subnormal lengths to near FLT_MAX, or the scene, origins and directions together from 1e-15 to
+1e30. Where the float test leaves its range a triangle is a miss on every path, never a hit that
+one path finds and another culls."""
 import numpy as np
 import pytest
 
