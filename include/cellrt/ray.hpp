@@ -21,6 +21,7 @@ namespace cellrt {
 inline constexpr std::uint32_t kNoHit = std::numeric_limits<std::uint32_t>::max();
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 inline constexpr float kLargestFloat = std::numeric_limits<float>::max();
+inline constexpr float kLeastNormal = std::numeric_limits<float>::min();  // 2^-126
 
 struct Ray {
     Vec3 org;
@@ -46,9 +47,9 @@ CELLRT_HD inline bool closer(float t, std::uint32_t prim, const Hit& best) {
 }
 
 [[gnu::always_inline]] CELLRT_HD inline bool is_valid(const Ray& r) {
-    constexpr float kLeast = 0x1p-126f;  // the least normal float
     return is_finite(r.org) && is_finite(r.dir) &&
-           (std::fabs(r.dir.x) >= kLeast || std::fabs(r.dir.y) >= kLeast || std::fabs(r.dir.z) >= kLeast) &&
+           (std::fabs(r.dir.x) >= kLeastNormal || std::fabs(r.dir.y) >= kLeastNormal ||
+            std::fabs(r.dir.z) >= kLeastNormal) &&
            !(r.tnear > r.tfar) && r.tnear < kInfinity && r.tfar == r.tfar;
 }
 

@@ -67,7 +67,7 @@ struct WatertightRay {
 // Whether the test's determinant is a normal float, neither zero, subnormal nor infinite (NaN fails).
 CELLRT_HD inline bool det_in_range(float det) {
     const float a = std::fabs(det);
-    return a >= 0x1p-126f && a < kInfinity;
+    return a >= kLeastNormal && a < kInfinity;
 }
 
 // Core of the test: on success writes t = T/det and the barycentrics, without any range check.

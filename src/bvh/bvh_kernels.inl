@@ -155,15 +155,13 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay
     const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
-    const F abs_det = abs_lanes(det);  // det_in_range and a finite t (triangle.hpp)
     const F az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
     const F big_t = eu * az + ev * bz + ew * cz;
     const F inv_det = splat(1.f) / det;
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return used & ~(negative & positive) & (abs_det >= splat(0x1p-126f)) & (abs_det < splat(kInfinity)) &
-           (abs_lanes(t) < splat(kInfinity));
+    return used & ~(negative & positive) & det_in_range_lanes(det) & (abs_lanes(t) < splat(kInfinity));  // triangle.hpp
 }
 
 // The lanes of a bit mask, as a lane mask.

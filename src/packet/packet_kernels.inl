@@ -128,14 +128,14 @@ inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask,
     const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
-    const F abs_det = abs_lanes(det);  // det_in_range (triangle.hpp); t's finiteness: the callers' bounds
     const F az = L.sz * a_kz, bz = L.sz * b_kz, cz = L.sz * c_kz;
     const F big_t = eu * az + ev * bz + ew * cz;
     const F inv_det = splat(1.f) / det;
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return mask & ~(negative & positive) & (abs_det >= splat(0x1p-126f)) & (abs_det < splat(kInfinity));
+    // t's finiteness (triangle.hpp) comes from the callers' bounds, clamped to the finite floats.
+    return mask & ~(negative & positive) & det_in_range_lanes(det);
 }
 
 // The permutation the lanes of `mask` share, or -1 when they differ.

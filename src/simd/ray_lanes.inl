@@ -10,6 +10,11 @@
 
 inline F abs_lanes(F x) { return (F)((I)x & splat_i(0x7fffffff)); }  // std::fabs clears the sign bit
 inline F max_lanes(F a, F b) { return select(a < b, b, a); }        // std::max's choice, lane by lane
+// det_in_range (triangle.hpp), lane by lane: the watertight test's determinant a normal float.
+inline I det_in_range_lanes(F det) {
+    const F a = abs_lanes(det);
+    return (a >= splat(kLeastNormal)) & (a < splat(kInfinity));
+}
 
 // TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the
 // finite floats. Lanes of invalid rays (ray.hpp) and lanes past n hold a harmless ray (origin 0,
@@ -37,7 +42,7 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     // with a component of at least 2^-126, tnear <= tfar, no NaN bound, tnear below +inf.
     I finite = loaded;
     for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
-    const F least = splat(0x1p-126f);
+    const F least = splat(kLeastNormal);
     const I normal_dir = (abs_lanes(d[0]) >= least) | (abs_lanes(d[1]) >= least) | (abs_lanes(d[2]) >= least);
     L.valid = finite & normal_dir & ~(L.tnear > L.tfar) & (L.tnear < splat(kInfinity)) & (L.tfar == L.tfar);
     // The bounds within the finite floats: a hit's t is finite (triangle.hpp), and the packets'
