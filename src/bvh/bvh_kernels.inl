@@ -161,7 +161,8 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return used & ~(negative & positive) & det_in_range_lanes(det) & (abs_lanes(t) < splat(kInfinity));  // triangle.hpp
+    // t's finiteness (triangle.hpp) comes from the queries' bounds, finite floats (finite_tfar).
+    return used & ~(negative & positive) & det_in_range_lanes(det);
 }
 
 // The lanes of a bit mask, as a lane mask.
@@ -425,7 +426,7 @@ void paired_batch(const BvhTree& tree, std::span<const Ray> rays, Counters& c, A
     // The walk of the ray take() returned last.
     const auto walk = [&](std::size_t i) {
         const PreparedRay& r = prepared[i % kLanes];
-        return Walk{r.box(), r.leaf(), Query(r.tnear, rays[i].tfar, r.margin)};
+        return Walk{r.box(), r.leaf(), Query(r.tnear, finite_tfar(rays[i].tfar), r.margin)};
     };
     // The walk left when the batch runs out goes on alone.
     const auto finish = [&](std::size_t i, Walk& w, std::uint32_t word, int size, BvhStacks<Query>& st) {

@@ -219,7 +219,7 @@ std::uint32_t prepare_stream(const BvhTree& tree, std::span<const Ray> rays, Str
             ++valid;
             s.rays[k] = group[i];
             s.index[k] = static_cast<std::uint32_t>(first + i);
-            queries[k] = Query(group[i].tnear, rays[first + i].tfar, group[i].margin);
+            queries[k] = Query(group[i].tnear, finite_tfar(rays[first + i].tfar), group[i].margin);
         }
     }
     if (!by_octant) ends[0] = valid;

@@ -127,6 +127,14 @@ struct WorkCounters {
     void triangle() { ++sum.triangles; }
 };
 
+// A ray's bounds within the finite floats, as the SIMD set-up clamps them (simd/ray_lanes.inl): a
+// hit's t is finite (triangle.hpp), and the BVH's leaf lanes leave that to the bounds, t >= tnear
+// and t <= tfar, rather than testing each lane's t. Only tnear = -inf and tfar = +inf move (a valid
+// ray has tnear below +inf and tnear <= tfar: ray.hpp). Written as maxss and minss take them (NaN,
+// an invalid ray's, becomes the bound).
+CELLRT_HD inline float finite_tnear(float t) { return t > -kLargestFloat ? t : -kLargestFloat; }
+CELLRT_HD inline float finite_tfar(float t) { return t < kLargestFloat ? t : kLargestFloat; }
+
 // Closest hit under the hit rule. Cells starting after best.t + margin cannot hold the answer.
 struct ClosestHit {
     static constexpr bool kAnyHit = false;
@@ -134,8 +142,10 @@ struct ClosestHit {
     float tnear;
     float margin;
 
-    CELLRT_HD explicit ClosestHit(const TraversalRay& r) : ClosestHit(r.tnear, r.tfar, r.margin) {}
-    // From the ray's interval and margin (TraversalRay's), as a SIMD set-up keeps them in lanes.
+    CELLRT_HD explicit ClosestHit(const TraversalRay& r)
+        : ClosestHit(finite_tnear(r.tnear), finite_tfar(r.tfar), r.margin) {}
+    // From the ray's interval, finite (finite_tnear, finite_tfar), and margin, as a SIMD set-up
+    // keeps them in lanes.
     CELLRT_HD ClosestHit(float t_near, float t_far, float m) : best{t_far, kNoHit, 0.f, 0.f}, tnear(t_near), margin(m) {}
 
     CELLRT_HD float cull_t() const { return best.t + margin; }
@@ -155,7 +165,8 @@ struct AnyHit {
     float tnear, tfar;
     float cull;
 
-    CELLRT_HD explicit AnyHit(const TraversalRay& r) : AnyHit(r.tnear, r.tfar, r.margin) {}
+    CELLRT_HD explicit AnyHit(const TraversalRay& r) : AnyHit(finite_tnear(r.tnear), finite_tfar(r.tfar), r.margin) {}
+    // From a finite interval, as ClosestHit's.
     CELLRT_HD AnyHit(float t_near, float t_far, float margin) : tnear(t_near), tfar(t_far), cull(t_far + margin) {}
 
     CELLRT_HD float cull_t() const { return cull; }
