@@ -100,7 +100,11 @@ inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_sce
     // along unit directions: at 1e20 the margin was inf / inf, NaN, and every structure culled the
     // whole scene; at 1e-17 the watertight test's T underflows to garbage t that the margin's
     // floor must cover. The hits there are few and meaningless, but every path must agree.
+    // At 1e15 the determinant is a normal float (some 1e30) but T, a length cubed, overflows along
+    // unit directions: t is +inf in front of the origin and -inf behind it, which the rays with
+    // tnear = -inf (RaySuite::limited) would take but for the queries' finite bounds.
     out.push_back({"soup at 1e20", soup(1e20f)});
+    out.push_back({"soup at 1e15", soup(1e15f)});
     out.push_back({"soup at 1e-17", soup(1e-17f)});
     return out;
 }

@@ -29,10 +29,10 @@ namespace {
 std::vector<std::string> exact_configs() {
     std::vector<std::string> out = {"kd:rec", "kd:branched", "kd:branchless", "bih:branched", "bih:branchless",
                                     "bih:branched@split=sah", "bih+auto@split=sah", "auto", "auto@packets=bih",
-                                    "auto@packets=bih-sah", "auto@packets=bvh", "auto@route=coherence", "auto@streams=off", "bvh:paired",
-                                    "bvh:stream", "bvh:packet"};
+                                    "auto@packets=bih-sah", "auto@packets=bvh", "auto@route=coherence", "auto@streams=off", "bvh:wide",
+                                    "bvh:paired", "bvh:stream", "bvh:packet"};
     for (detail::Isa isa : detail::available_isas())
-        for (const char* kind : {"kd", "bih", "bvh", "bvh:paired", "bvh:stream", "bvh:packet"})
+        for (const char* kind : {"kd", "bih", "bvh", "bvh:wide", "bvh:paired", "bvh:stream", "bvh:packet"})
             out.push_back(std::string(kind) + "+" + detail::to_string(isa));
     return out;
 }
@@ -73,6 +73,38 @@ TEST_P(DegenerateInputs, SameHits) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Structures, DegenerateInputs, testing::ValuesIn(kConfigs),
+                         [](const auto& info) { return name_of(info.param); });
+
+// The suite's rays unbounded behind their origins (tnear = -inf) over the soups whose T overflows
+// (1e15: t = -inf behind the origin along unit directions, with a normal determinant) or whose
+// determinant does (1e20): brute force's scalar test refuses a t that is not finite, and a SIMD
+// kernel that leaves that to the query's bounds must find them finite (kernel/traversal.hpp,
+// finite_tnear; with it taken out, `bvh:wide` takes the t = -inf hits).
+class UnboundedBehind : public testing::TestWithParam<std::string> {};
+
+TEST_P(UnboundedBehind, SameHits) {
+    struct Case {
+        const char* name;
+        std::vector<Triangle> tris;
+        test::ReferenceAnswers ref;
+    };
+    static const std::vector<Case> cases = [] {
+        std::vector<Case> out;
+        for (const auto& [name, scale] : {std::pair{"1e15", 1e15f}, std::pair{"1e20", 1e20f}}) {
+            std::vector<Triangle> tris = test::soup(scale);
+            std::vector<Ray> rays = test::RaySuite(tris, test::small_suite()).rays();
+            for (Ray& r : rays) r.tnear = -kInfinity;
+            test::ReferenceAnswers ref = test::compute_reference(tris, std::move(rays));
+            out.push_back({name, std::move(tris), std::move(ref)});
+        }
+        return out;
+    }();
+    for (const Case& c : cases)
+        test::expect_matches(*make_accelerator(c.tris, parse_accel_config(GetParam())), c.ref,
+                             GetParam() + " on the soup at " + c.name + ", tnear = -inf");
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, UnboundedBehind, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
 
 // A scene and its (valid) rays scaled by a power of two, vertices, origins and directions alike:

@@ -9,7 +9,8 @@
 // popped past the query's cull distance.
 // A leaf: the watertight test (triangle.hpp) of its triangles, lane by lane in the scalar test's
 // operations and order, so each lane's t, u and v are the scalar test's bits; the hit rule then picks
-// among the lanes. Hence the kernels return exactly the hits of brute force.
+// among the lanes. Hence the kernels return exactly the hits of brute force (the lanes leave t's
+// finiteness to the queries' bounds, which are finite: kernel/traversal.hpp).
 //
 // No include guard: every instruction set's unit includes it once, in a namespace of its own.
 
@@ -161,7 +162,8 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    // t's finiteness (triangle.hpp) comes from the queries' bounds, finite floats (finite_tfar).
+    // t's finiteness (triangle.hpp) comes from the queries' bounds, finite floats (finite_tnear and
+    // finite_tfar, kernel/traversal.hpp): an infinite or NaN t fails the acceptance that follows.
     return used & ~(negative & positive) & det_in_range_lanes(det);
 }
 

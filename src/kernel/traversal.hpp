@@ -127,11 +127,12 @@ struct WorkCounters {
     void triangle() { ++sum.triangles; }
 };
 
-// A ray's bounds within the finite floats, as the SIMD set-up clamps them (simd/ray_lanes.inl): a
-// hit's t is finite (triangle.hpp), and the BVH's leaf lanes leave that to the bounds, t >= tnear
-// and t <= tfar, rather than testing each lane's t. Only tnear = -inf and tfar = +inf move (a valid
-// ray has tnear below +inf and tnear <= tfar: ray.hpp). Written as maxss and minss take them (NaN,
-// an invalid ray's, becomes the bound).
+// A query's bounds within the finite floats, as the SIMD set-up clamps a ray's (simd/ray_lanes.inl):
+// a hit's t is finite (triangle.hpp), and the BVH's leaf lanes leave that to the bounds, t >= tnear
+// and t <= tfar (or best.t), rather than testing each lane's t. Only tnear = -inf and tfar = +inf
+// move (a valid ray has tnear below +inf and tnear <= tfar: ray.hpp). Written as maxss and minss
+// take them, one instruction each (as `x > b ? b : x` they compiled to a compare and a blend); a
+// NaN, an invalid ray's, becomes the bound, where the lanes keep it.
 CELLRT_HD inline float finite_tnear(float t) { return t > -kLargestFloat ? t : -kLargestFloat; }
 CELLRT_HD inline float finite_tfar(float t) { return t < kLargestFloat ? t : kLargestFloat; }
 
@@ -144,8 +145,10 @@ struct ClosestHit {
 
     CELLRT_HD explicit ClosestHit(const TraversalRay& r)
         : ClosestHit(finite_tnear(r.tnear), finite_tfar(r.tfar), r.margin) {}
-    // From the ray's interval, finite (finite_tnear, finite_tfar), and margin, as a SIMD set-up
-    // keeps them in lanes.
+    // From the ray's interval and margin, as a SIMD set-up keeps them in lanes: the bounds finite
+    // (finite_tnear, finite_tfar), which the caller ensures. Clamping them here again cost the BVH's
+    // packets and paired walks 0.5 to 1.2 % of their instructions (docs/INCOHERENT.md, eighteenth
+    // round); Structures/UnboundedBehind fails on any path whose bounds are not finite.
     CELLRT_HD ClosestHit(float t_near, float t_far, float m) : best{t_far, kNoHit, 0.f, 0.f}, tnear(t_near), margin(m) {}
 
     CELLRT_HD float cull_t() const { return best.t + margin; }
@@ -166,7 +169,7 @@ struct AnyHit {
     float cull;
 
     CELLRT_HD explicit AnyHit(const TraversalRay& r) : AnyHit(finite_tnear(r.tnear), finite_tfar(r.tfar), r.margin) {}
-    // From a finite interval, as ClosestHit's.
+    // From finite bounds, as ClosestHit's.
     CELLRT_HD AnyHit(float t_near, float t_far, float margin) : tnear(t_near), tfar(t_far), cull(t_far + margin) {}
 
     CELLRT_HD float cull_t() const { return cull; }

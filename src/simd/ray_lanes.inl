@@ -46,7 +46,8 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     const I normal_dir = (abs_lanes(d[0]) >= least) | (abs_lanes(d[1]) >= least) | (abs_lanes(d[2]) >= least);
     L.valid = finite & normal_dir & ~(L.tnear > L.tfar) & (L.tnear < splat(kInfinity)) & (L.tfar == L.tfar);
     // The bounds within the finite floats: a hit's t is finite (triangle.hpp), and the packets'
-    // triangle test leaves that to these bounds rather than testing each lane's t.
+    // triangle test and the BVH's leaf lanes leave that to these bounds (and the queries made from
+    // them, kernel/traversal.hpp) rather than testing each lane's t.
     L.tnear = max_lanes(L.tnear, splat(-kLargestFloat));
     L.tfar = select(L.tfar > splat(kLargestFloat), splat(kLargestFloat), L.tfar);
     F reach[3];
