@@ -107,6 +107,60 @@ TEST_P(UnboundedBehind, SameHits) {
 INSTANTIATE_TEST_SUITE_P(Structures, UnboundedBehind, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
 
+// Directions with a component below 2^-126 beside a normal one (valid rays): its reciprocal
+// overflows below about 2.9e-39, and every structure missed the first strip below, 1e-35 off the
+// axis, which brute force hit at t = 1.5e5 (review, 2026-12-06). Every path now traces such a
+// component as a zero of its sign (ray.hpp, traced_direction), brute force too, so all miss that
+// strip; components just above 2^-126 still reach the second strip, 1e-33 off the axis.
+class SubnormalDirectionComponents : public testing::TestWithParam<std::string> {};
+
+TEST_P(SubnormalDirectionComponents, SameHits) {
+    static const auto scene = [] {
+        // Strips across the x axis at x = +-1.5e5, off it in y or z by [lo, hi] on either side.
+        std::vector<Triangle> tris;
+        const auto strip = [&](float x, int axis, float lo, float hi) {
+            const auto at = [&](float off, float across) {
+                Vec3 p{x, 0.f, 0.f};
+                p[axis] = off;
+                p[3 - axis] = across;
+                return p;
+            };
+            tris.push_back({at(lo, -1.f), at(hi, -1.f), at(hi, 1.f)});
+            tris.push_back({at(lo, -1.f), at(hi, 1.f), at(lo, 1.f)});
+        };
+        for (const float x : {1.5e5f, -1.5e5f})
+            for (int axis : {1, 2})
+                for (const float side : {1.f, -1.f}) {
+                    strip(x, axis, side * 1e-36f, side * 1e-34f);
+                    strip(x, axis, side * 2e-34f, side * 2e-32f);
+                }
+        std::vector<Ray> rays;
+        for (const float along : {1.f, -1.f, 3.f})
+            for (const float s : {3e-40f, 1e-39f, 1e-45f, 1.2e-38f, 2e-38f, 5e-38f})
+                for (const float sign : {1.f, -1.f})
+                    for (int axis : {1, 2}) {
+                        Ray r;
+                        r.dir = {along, 0.f, 0.f};
+                        r.dir[axis] = sign * s;
+                        rays.push_back(r);
+                    }
+        return std::pair{tris, test::compute_reference(tris, std::move(rays))};
+    }();
+    const auto& [tris, ref] = scene;
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < ref.rays.size(); ++i) {
+        hits += ref.hits[i].is_hit();
+        const float s = std::max(std::fabs(ref.rays[i].dir.y), std::fabs(ref.rays[i].dir.z));
+        if (s < kLeastNormal) EXPECT_FALSE(ref.hits[i].is_hit()) << "brute force traces ray " << i << "'s component as 0";
+    }
+    ASSERT_GT(hits, ref.rays.size() / 4) << "the normal components must reach the second strip";
+    test::expect_matches(*make_accelerator(tris, parse_accel_config(GetParam())), ref,
+                         GetParam() + " on directions with subnormal components");
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, SubnormalDirectionComponents, testing::ValuesIn(kConfigs),
+                         [](const auto& info) { return name_of(info.param); });
+
 // A scene and its (valid) rays scaled by a power of two, vertices, origins and directions alike:
 // every step of the watertight test scales exactly, so brute force finds the unscaled hits (triangle
 // and t; the barycentrics can differ where an edge function leaves the normal range, and t where T

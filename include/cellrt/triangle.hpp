@@ -53,14 +53,18 @@ struct WatertightRay {
     int kx = 0, ky = 1, kz = 2;
     float sx = 0.f, sy = 0.f, sz = 0.f;
 
-    CELLRT_HD explicit WatertightRay(const Ray& r) : org(r.org) {
-        kz = max_axis(r.dir);
+    // Of the traced direction (ray.hpp, traced_direction: subnormal components as zeros), as every
+    // traversal's.
+    CELLRT_HD explicit WatertightRay(const Ray& r) : WatertightRay(r.org, traced_direction(r)) {}
+    // From an origin and a direction already traced (TraversalRay's, which flushes it once for both).
+    CELLRT_HD WatertightRay(const Vec3& o, const Vec3& traced) : org(o) {
+        kz = max_axis(traced);
         kx = kz == 2 ? 0 : kz + 1;
         ky = kx == 2 ? 0 : kx + 1;
-        if (r.dir[kz] < 0.f) std::swap(kx, ky);  // keeps the winding, so the sign test is orientation-free
-        sx = r.dir[kx] / r.dir[kz];
-        sy = r.dir[ky] / r.dir[kz];
-        sz = 1.f / r.dir[kz];
+        if (traced[kz] < 0.f) std::swap(kx, ky);  // keeps the winding, so the sign test is orientation-free
+        sx = traced[kx] / traced[kz];
+        sy = traced[ky] / traced[kz];
+        sz = 1.f / traced[kz];
     }
 };
 

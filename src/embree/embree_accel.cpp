@@ -104,9 +104,12 @@ void store_ray(EmbreeRay& er, int k, const Ray& r) {
     lane(er.org_y, k) = r.org.y;
     lane(er.org_z, k) = r.org.z;
     lane(er.tnear, k) = r.tnear;
-    lane(er.dir_x, k) = r.dir.x;
-    lane(er.dir_y, k) = r.dir.y;
-    lane(er.dir_z, k) = r.dir.z;
+    // The direction every path of cellrt traces (ray.hpp: subnormal components as zeros), so that
+    // Embree answers the same ray.
+    const Vec3 d = traced_direction(r);
+    lane(er.dir_x, k) = d.x;
+    lane(er.dir_y, k) = d.y;
+    lane(er.dir_z, k) = d.z;
     lane(er.time, k) = 0.f;
     lane(er.tfar, k) = r.tfar;
     lane(er.mask, k) = ~0u;

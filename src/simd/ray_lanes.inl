@@ -43,7 +43,9 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     I finite = loaded;
     for (int a = 0; a < 3; ++a) finite &= ((o[a] - o[a]) == 0.f) & ((d[a] - d[a]) == 0.f);
     const F least = splat(kLeastNormal);
-    const I normal_dir = (abs_lanes(d[0]) >= least) | (abs_lanes(d[1]) >= least) | (abs_lanes(d[2]) >= least);
+    I normal[3];
+    for (int a = 0; a < 3; ++a) normal[a] = abs_lanes(d[a]) >= least;
+    const I normal_dir = normal[0] | normal[1] | normal[2];
     L.valid = finite & normal_dir & ~(L.tnear > L.tfar) & (L.tnear < splat(kInfinity)) & (L.tfar == L.tfar);
     // The bounds within the finite floats: a hit's t is finite (triangle.hpp), and the packets'
     // triangle test and the BVH's leaf lanes leave that to these bounds (and the queries made from
@@ -53,7 +55,8 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
     F reach[3];
     for (int a = 0; a < 3; ++a) {
         L.org[a] = select(L.valid, o[a], splat(0.f));
-        L.dir[a] = select(L.valid, d[a], splat(1.f));
+        // traced_direction (ray.hpp): a subnormal component is a zero of its sign.
+        L.dir[a] = select(L.valid, select(normal[a], d[a], (F)((I)d[a] & splat_i(INT32_MIN))), splat(1.f));
         L.inv[a] = splat(1.f) / L.dir[a];
         L.negative[a] = (I)L.dir[a] < 0;
         reach[a] = max_lanes(abs_lanes(splat(scene.lo[a]) - L.org[a]), abs_lanes(splat(scene.hi[a]) - L.org[a]));
