@@ -56,7 +56,11 @@ struct WatertightRay {
     // Of the traced direction (ray.hpp, traced_direction: subnormal components as zeros), as every
     // traversal's.
     CELLRT_HD explicit WatertightRay(const Ray& r) : WatertightRay(r.org, traced_direction(r)) {}
-    // From an origin and a direction already traced (TraversalRay's, which flushes it once for both).
+    // From an origin and traced_direction(r) of a valid ray r, already made (TraversalRay makes it
+    // once for both); a raw direction would not be the ray every path traces.
+    CELLRT_HD static WatertightRay of_traced(const Vec3& o, const Vec3& traced) { return WatertightRay(o, traced); }
+
+private:
     CELLRT_HD WatertightRay(const Vec3& o, const Vec3& traced) : org(o) {
         kz = max_axis(traced);
         kx = kz == 2 ? 0 : kz + 1;

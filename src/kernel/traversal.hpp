@@ -80,7 +80,7 @@ struct TraversalRay {
 
     // Always inlined, with clip() and the triangle test (triangle.hpp): see intersect_unbounded.
     [[gnu::always_inline]] CELLRT_HD TraversalRay(const Ray& r, const Box3& scene_box)
-        : org(r.org), dir(traced_direction(r)), tnear(r.tnear), tfar(r.tfar), watertight(org, dir) {
+        : org(r.org), dir(traced_direction(r)), tnear(r.tnear), tfar(r.tfar), watertight(WatertightRay::of_traced(org, dir)) {
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.f / dir[a];
             dir_neg[a] = std::signbit(dir[a]) ? 1u : 0u;
