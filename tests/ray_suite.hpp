@@ -86,10 +86,8 @@ public:
 
     const std::vector<Ray>& rays() const { return rays_; }
 
-    // Copies of `rays` with tfar cut at the reference hit (exactly, and one ulp before), with tnear
-    // moved past it, so interval limits are checked at their edges, and unbounded both ways
-    // ([-inf, inf]: the triangles behind the origin count too, and where T overflows, a t of -inf,
-    // which no path may take: every query's bounds are finite, kernel/traversal.hpp).
+    // Copies of `rays` with tfar cut at the reference hit (exactly, and one ulp before) and with
+    // tnear moved past it, so interval limits are checked at their edges.
     static std::vector<Ray> limited(const std::vector<Ray>& rays, const std::vector<Hit>& reference) {
         std::vector<Ray> out;
         for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -103,8 +101,6 @@ public:
             r.tnear = reference[i].t;
             out.push_back(r);
             r.tnear = std::nextafter(reference[i].t, kInfinity);
-            out.push_back(r);
-            r.tnear = -kInfinity;
             out.push_back(r);
         }
         return out;
