@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -229,12 +230,21 @@ inline ReferenceAnswers compute_reference(std::span<const Triangle> tris, std::v
     return ref;
 }
 
+inline constexpr std::size_t kSuiteLimitedCount = 20000;
+
+// The first `limited_count` of RaySuite::limited(rays, hits).
+inline std::vector<Ray> first_limited(const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                      std::size_t limited_count) {
+    std::vector<Ray> limited = RaySuite::limited(rays, hits);
+    if (limited.size() > limited_count) limited.resize(limited_count);
+    return limited;
+}
+
 // The suite's rays, followed by up to `limited_count` of them limited at their reference hits.
 inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {},
-                                        std::size_t limited_count = 20000) {
+                                        std::size_t limited_count = kSuiteLimitedCount) {
     ReferenceAnswers ref = compute_reference(tris, RaySuite(tris, options).rays());
-    std::vector<Ray> limited = RaySuite::limited(ref.rays, ref.hits);
-    if (limited.size() > limited_count) limited.resize(limited_count);
+    std::vector<Ray> limited = first_limited(ref.rays, ref.hits, limited_count);
     ReferenceAnswers lim = compute_reference(tris, std::move(limited));
     ref.rays.insert(ref.rays.end(), lim.rays.begin(), lim.rays.end());
     ref.hits.insert(ref.hits.end(), lim.hits.begin(), lim.hits.end());
@@ -301,16 +311,24 @@ inline std::string reference_cache_dir() {
     return CELLRT_TEST_CACHE;
 }
 
-// The answers `compute` gives, kept on disk under a key made of the triangles and `rays` (the rays
-// the answers start from): one process computes, those that need the same answers wait for its file.
-template <class Compute>
-ReferenceAnswers stored_answers(std::span<const Triangle> tris, std::span<const Ray> rays, Compute compute) {
+// Where stored_answers() keeps the answers that start from `rays` on `tris`.
+inline std::string stored_answers_path(std::span<const Triangle> tris, std::span<const Ray> rays) {
     const std::uint64_t h = detail::fnv1a(rays.data(), rays.size_bytes(), detail::fnv1a(tris.data(), tris.size_bytes()));
     const std::string dir = reference_cache_dir();
     std::filesystem::create_directories(dir);
     char name[32];
     std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(h));
-    const std::string path = dir + "/" + name + ".ref";
+    return dir + "/" + name + ".ref";
+}
+
+// The answers `compute` gives, kept on disk under a key made of the triangles and `rays` (the rays
+// the answers start from): one process computes, those that need the same answers wait for its file.
+// A cached file is used only if `consistent` accepts it: the key holds the rays the answers start
+// from, not the rays derived from them (the limited copies), which the test code may have changed.
+template <class Compute, class Consistent>
+ReferenceAnswers stored_answers(std::span<const Triangle> tris, std::span<const Ray> rays, Compute compute,
+                                Consistent consistent) {
+    const std::string path = stored_answers_path(tris, rays);
     const int lock_fd = ::open((path + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
     if (lock_fd >= 0) ::flock(lock_fd, LOCK_EX);
     ReferenceAnswers ref;
@@ -320,7 +338,8 @@ ReferenceAnswers stored_answers(std::span<const Triangle> tris, std::span<const 
         std::uint64_t n = 0;
         if (in.read(reinterpret_cast<char*>(&n), sizeof n)) expected = n;
     }
-    if (expected == 0 || !detail::read_reference(path, expected, ref) || !detail::sample_agrees(tris, ref)) {
+    if (expected == 0 || !detail::read_reference(path, expected, ref) || !consistent(ref) ||
+        !detail::sample_agrees(tris, ref)) {
         ref = compute();
         detail::write_reference(path, ref);
     }
@@ -333,13 +352,27 @@ ReferenceAnswers stored_answers(std::span<const Triangle> tris, std::span<const 
 
 // compute_reference() of `rays`, kept on disk: the tests of every structure on one scene's frame share it.
 inline ReferenceAnswers stored_reference(std::span<const Triangle> tris, const std::vector<Ray>& rays) {
-    return stored_answers(tris, rays, [&] { return compute_reference(tris, rays); });
+    return stored_answers(
+        tris, rays, [&] { return compute_reference(tris, rays); },
+        [&](const ReferenceAnswers& ref) {
+            return ref.rays.size() == rays.size() &&
+                   std::memcmp(ref.rays.data(), rays.data(), rays.size() * sizeof(Ray)) == 0;
+        });
 }
 
 // reference_suite() of `tris`, kept on disk: the tests of every structure on the same triangles share it.
 inline ReferenceAnswers stored_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {}) {
     const std::vector<Ray> rays = RaySuite(tris, options).rays();
-    return stored_answers(tris, rays, [&] { return reference_suite(tris, options); });
+    return stored_answers(
+        tris, rays, [&] { return reference_suite(tris, options); },
+        [&](const ReferenceAnswers& ref) {
+            const std::size_t n = rays.size();
+            if (ref.rays.size() < n || std::memcmp(ref.rays.data(), rays.data(), n * sizeof(Ray)) != 0) return false;
+            const std::vector<Ray> limited =
+                first_limited(rays, std::vector<Hit>(ref.hits.begin(), ref.hits.begin() + n), kSuiteLimitedCount);
+            return ref.rays.size() - n == limited.size() &&
+                   std::memcmp(ref.rays.data() + n, limited.data(), limited.size() * sizeof(Ray)) == 0;
+        });
 }
 
 // reference_suite() of a triangle set, computed once and shared by every structure and traversal

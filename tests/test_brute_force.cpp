@@ -26,6 +26,40 @@ TEST(BruteForce, SuiteCoversHitsMissesAndInvalidRays) {
     EXPECT_EQ(test::expect_matches(*brute, ref, "brute force"), 0u);
 }
 
+// The cache's key holds the suite's base rays only; a file whose limited copies differ from what
+// RaySuite::limited makes of its hits (written by an older version of the test code) must be
+// recomputed, not trusted: a sample of every 97th answer would pass it, the answers being right for
+// the rays the file holds.
+TEST(BruteForce, StoredSuiteRecomputesStaleLimitedRays) {
+    const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
+    test::RaySuiteOptions few;
+    few.random = few.inside = few.vertices = few.edges = 300;
+    few.axis_parallel = 120;
+    few.planes = 200;
+    const test::ReferenceAnswers fresh = test::reference_suite(scene.triangles, few);
+    const std::string dir = ::testing::TempDir() + "cellrt_stale_cache_" + std::to_string(::getpid());
+    const char* previous = std::getenv("CELLRT_TEST_CACHE");
+    const std::string saved = previous ? previous : "";
+    ASSERT_EQ(::setenv("CELLRT_TEST_CACHE", dir.c_str(), 1), 0);
+    const test::ReferenceAnswers first = test::stored_suite(scene.triangles, few);
+    ASSERT_EQ(first.rays.size(), fresh.rays.size());
+
+    const std::string path =
+        test::stored_answers_path(scene.triangles, test::RaySuite(scene.triangles, few).rays());
+    test::ReferenceAnswers stale = first;
+    const std::size_t last = stale.rays.size() - 1;
+    ASSERT_NE(last % 97, 0u);
+    stale.rays[last].tfar = std::nextafter(stale.rays[last].tfar, 0.f);
+    test::detail::write_reference(path, stale);
+
+    const test::ReferenceAnswers again = test::stored_suite(scene.triangles, few);
+    ASSERT_EQ(again.rays.size(), fresh.rays.size());
+    EXPECT_EQ(std::memcmp(again.rays.data(), fresh.rays.data(), fresh.rays.size() * sizeof(Ray)), 0);
+    std::filesystem::remove_all(dir);
+    if (previous) ::setenv("CELLRT_TEST_CACHE", saved.c_str(), 1);
+    else ::unsetenv("CELLRT_TEST_CACHE");
+}
+
 TEST(BruteForce, RejectsUnknownParameterAndTraversal) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=600");
     AccelConfig c{"brute"};
