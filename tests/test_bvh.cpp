@@ -877,7 +877,7 @@ TEST(Routed, IsTheDefaultOnTheCpu) {
 }
 
 // `packets=bvh` builds one tree for every path: the route's memory is the BVH's, and its packets are
-// the BVH's eight rays at a time.
+// the BVH's: eight rays at a time, sixteen with AVX-512's kernels.
 TEST(Routed, BvhPacketsRouteHoldsOneTree) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const AccelStats one = make_accelerator(scene.triangles, AccelConfig{"bvh"})->stats();
@@ -885,8 +885,14 @@ TEST(Routed, BvhPacketsRouteHoldsOneTree) {
     const AccelStats two = make_accelerator(scene.triangles, parse_accel_config("auto"))->stats();
     EXPECT_EQ(routed.memory_bytes, one.memory_bytes);
     EXPECT_GT(two.memory_bytes, one.memory_bytes);  // the kd-tree and the BVH
-    EXPECT_EQ(routed.simd_lanes, detail::kBvhWidth);
-    EXPECT_EQ(make_accelerator(scene.triangles, parse_accel_config("bvh:packet"))->stats().simd_lanes, detail::kBvhWidth);
+    const AccelStats packets = make_accelerator(scene.triangles, parse_accel_config("bvh:packet"))->stats();
+    EXPECT_EQ(packets.simd_lanes, packets.setting("isa") == "avx512" ? 16 : detail::kBvhWidth);
+    EXPECT_EQ(routed.simd_lanes, packets.simd_lanes);
+    for (const detail::Isa isa : detail::available_isas()) {
+        const std::string name = detail::to_string(isa);
+        const AccelStats s = make_accelerator(scene.triangles, parse_accel_config("bvh:packet+" + name))->stats();
+        EXPECT_EQ(s.simd_lanes, isa == detail::Isa::avx512 ? 16 : detail::kBvhWidth) << name;
+    }
     EXPECT_EQ(one.simd_lanes, 0);
 }
 

@@ -1,5 +1,6 @@
-// The kernels compiled for AVX-512: the SIMD packet kernels of every listed structure (16 lanes) and
-// the wide BVH's (eight lanes, in a namespace of their own), in a target region of their own.
+// The kernels compiled for AVX-512: the SIMD packet kernels of every listed structure (16 lanes),
+// the wide BVH's (eight lanes, in a namespace of their own) and its packets of sixteen rays, in a
+// target region of their own.
 #include "accel/isa_unit.hpp"
 
 #if defined(__x86_64__)
@@ -20,6 +21,29 @@ constexpr int kLanes = kBvhWidth;
 #include "simd/lanes.inl"
 #include "bvh/bvh_kernels.inl"
 }  // namespace wide
+// The wide BVH's packets of sixteen rays, one per lane of this set (bvh_packet.inl), over its
+// eight-lane nodes and leaves.
+using wide::BoxRay;
+using wide::kBvhStackSize;
+using wide::kBvhStackSlack;
+using wide::LeafRay;
+using wide::leaf_ray_of_lane;
+using wide::miss_all;
+using wide::node_children;
+using wide::prefetch_child;
+using wide::test_leaf;
+using wide::traverse_bvh_from;
+#include "bvh/bvh_packet.inl"
+inline const BvhKernels& bvh_kernels() {
+    static const BvhKernels k = [] {
+        BvhKernels with16 = wide::bvh_kernels("avx512");
+        with16.packet_closest = &closest_packet_batch;
+        with16.packet_any = &any_packet_batch;
+        with16.packet_rays = kPacketRays;
+        return with16;
+    }();
+    return k;
+}
 #undef CELLRT_SIMD_AVX512
 }  // namespace cellrt::detail::isa_avx512
 #if defined(__clang__)
@@ -29,7 +53,7 @@ constexpr int kLanes = kBvhWidth;
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx512() { return isa_avx512::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return isa_avx512::wide::bvh_kernels("avx512"); }
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return isa_avx512::bvh_kernels(); }
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx512() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return bvh_kernels_portable(); }

@@ -3,7 +3,7 @@
 // square tiles of primary rays and shadow rays toward one light) and the wide BVH (fastest on
 // incoherent batches: diffuse bounces, AO, random queries), the latter traced as single rays two at a
 // time (bvh:paired), as a stream (unless streams=off; bvh_stream.inl: the batch's rays down the tree
-// together) or in packets of eight rays (unless bvh_packets=off; bvh_packet.inl). With packets=bvh
+// together) or in packets of eight rays, sixteen on AVX-512 (unless bvh_packets=off; bvh_packet.inl). With packets=bvh
 // the BVH's own packets are the coherent batches' path: one tree, one build. It routes each batch by
 // its coherence and by the time per ray each path has taken on batches of its kind (docs/BVH.md,
 // docs/INCOHERENT.md).

@@ -38,7 +38,7 @@ public:
         AccelStats s;
         s.name = "bvh";
         s.traversal = bvh_traversals()[static_cast<std::size_t>(traversal_)];
-        if (traversal_ == Traversal::packet) s.simd_lanes = detail::kBvhWidth;  // eight rays, one a lane
+        if (traversal_ == Traversal::packet) s.simd_lanes = kernels_.packet_rays;  // one ray a lane
         s.build_seconds = build_seconds_;
         s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = tree().nodes.size() * sizeof(detail::BvhNode) + tree().leaves.size() * sizeof(detail::BvhLeaf);

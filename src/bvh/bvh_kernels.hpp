@@ -21,9 +21,11 @@ struct BvhKernels {
     // The stream traversal (bvh_stream.inl): the batch's rays down the tree together.
     void (*stream_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*stream_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
-    // The packet traversal (bvh_packet.inl): eight consecutive rays of the batch, one per lane.
+    // The packet traversal (bvh_packet.inl): packet_rays consecutive rays of the batch, one per lane
+    // (eight; sixteen on AVX-512).
     void (*packet_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*packet_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);
+    int packet_rays;
     // Two rays of the batch walked at once (bvh_kernels.inl, paired_batch).
     void (*paired_closest)(const BvhTree&, std::span<const Ray>, std::span<Hit>, TraversalCounters*);
     void (*paired_any)(const BvhTree&, std::span<const Ray>, std::span<std::uint8_t>, TraversalCounters*);

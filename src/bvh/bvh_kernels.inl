@@ -105,8 +105,15 @@ struct alignas(64) PreparedRay {
 };
 static_assert(sizeof(PreparedRay) == 64, "a prepared ray is one cache line");
 
-// Lane i's ray of `w` as the leaf test reads it.
-inline LeafRay leaf_ray_of_lane(const WatertightLanes& w, int i) {
+// The node's child slots that hold a child (not kEmptyChild), as bits.
+inline unsigned node_children(const BvhNode& node) {
+    return bits(reinterpret_cast<I>(load_u(node.child)) != splat_i(static_cast<std::int32_t>(BvhNode::kEmptyChild)));
+}
+
+// Lane i's ray of `w` (WatertightLanes of this namespace's eight lanes, or of the packets' sixteen:
+// bvh_packet.inl) as the leaf test reads it.
+template <class Lanes>
+inline LeafRay leaf_ray_of_lane(const Lanes& w, int i) {
     const float o[3] = {w.org[0][i], w.org[1][i], w.org[2][i]}, s[3] = {w.shear[0][i], w.shear[1][i], w.shear[2][i]};
     return LeafRay(o, s, w.kx[i], w.ky[i], w.kz[i]);
 }
@@ -518,19 +525,9 @@ inline void prefetch_child(const BvhNode* nodes, const BvhLeaf* leaves, std::uin
 #include "bvh/bvh_stream.inl"
 #include "bvh/bvh_packet.inl"
 
-inline void closest_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
-                                 TraversalCounters* counters) {
-    packet_batch<ClosestHit>(tree, rays, hits, counters);
-}
-
-inline void any_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
-                             TraversalCounters* counters) {
-    packet_batch<AnyHit>(tree, rays, occluded, counters);
-}
-
 inline const BvhKernels& bvh_kernels(const char* isa) {
     static const BvhKernels k{&closest_batch,        &any_batch,        &closest_stream_batch, &any_stream_batch,
-                              &closest_packet_batch, &any_packet_batch, &closest_paired_batch, &any_paired_batch,
-                              isa};
+                              &closest_packet_batch, &any_packet_batch, kPacketRays, &closest_paired_batch,
+                              &any_paired_batch,     isa};
     return k;
 }

@@ -1,10 +1,10 @@
 // Packets of rays over the wide BVH (issue 18; after Wald, Benthin, Boulos 2008, "Getting Rid of
-// Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8): eight consecutive rays
-// of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
+// Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8/16): eight (or sixteen,
+// below) consecutive rays of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
 // against the packet's rays at once, giving the rays that meet it; the packet goes on to the children
 // some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
 // query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top).
-// So a coherent packet reads each node, pops the stack and takes each branch once for its eight rays,
+// So a coherent packet reads each node, pops the stack and takes each branch once for all its rays,
 // where single rays (bvh_kernels.inl) do it once per ray; the arithmetic is the same. When few rays
 // are left on a branch (kPacketSingleBelow) each goes on alone, with the single-ray kernel, from the
 // node it reached.
@@ -17,10 +17,42 @@
 // past the ray's own entry, where its own kernel drops the branch too. The hit rule picks the same
 // answer whatever the order, so the answers are brute force's.
 //
-// No include guard: included after bvh_kernels.inl in each instruction set's namespace.
+// The packet is as wide as the namespace it is included in: after bvh_kernels.inl in the wide BVH's
+// namespace of eight lanes, or (AVX-512) in its instruction set's namespace of sixteen lanes, with
+// the wide BVH's node, leaf and single-ray names brought in by using-declarations: sixteen rays
+// share each node's fetch and loop, while a child's box and a leaf's triangles are still tested in
+// eight lanes (Embree's rtcIntersect16 over its BVH8 likewise).
+//
+// No include guard: included once per namespace of lanes that traces packets.
 
 // Rays per packet: one per lane.
 inline constexpr int kPacketRays = kLanes;
+static_assert(kPacketRays <= 32, "a packet's rays are the bits of an unsigned");
+
+// Lane i true where bit i of `rays` is set.
+inline I packet_lanes(unsigned rays) {
+    const I bit = []<std::size_t... L>(std::index_sequence<L...>) {
+        return I{static_cast<std::int32_t>(1u << L)...};
+    }(std::make_index_sequence<kPacketRays>());
+    return (splat_i(static_cast<std::int32_t>(rays)) & bit) != 0;
+}
+
+// The smallest of a packet's lanes (eight or sixteen): halves folded onto each other.
+template <class V>
+inline float packet_min(V x) {
+    const auto lesser = [](auto a, auto b) { return b < a ? b : a; };  // min_keep's choice
+    if constexpr (sizeof(V) == 64) {
+        return packet_min(lesser(__builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7),
+                                 __builtin_shufflevector(x, x, 8, 9, 10, 11, 12, 13, 14, 15)));
+    } else {
+        static_assert(sizeof(V) == 32, "packets of eight or sixteen rays");
+        x = lesser(x, __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3));
+        x = lesser(x, __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5));
+        x = lesser(x, __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6));
+        return x[0];
+    }
+}
+
 // A branch that this many rays of a packet or fewer go down is traced by each ray alone (the
 // single-ray kernel), as Embree's hybrid traversal falls back to single rays when few lanes are left.
 // Any hit: three, which traces a frame's shadow rays in 0.86 to 0.92 of the time one takes and AO
@@ -90,8 +122,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
             } else {
                 const BvhNode& node = nodes[word];
                 for (unsigned m = mask; m; m &= m - 1) c.node();
-                const I words = reinterpret_cast<I>(load_u(node.child));
-                unsigned children = bits(words != splat_i(-1));  // kEmptyChild: no box
+                unsigned children = node_children(node);
                 unsigned met = 0, next = 0;
                 unsigned child_rays[kBvhWidth];
                 float key[kBvhWidth];
@@ -105,7 +136,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
                     if constexpr (kAny) {
                         if (!met) next = static_cast<unsigned>(k);
                     } else {
-                        key[k] = horizontal_min(select(met_mask(m), entry, splat(kInfinity)));
+                        key[k] = packet_min(select(packet_lanes(m), entry, splat(kInfinity)));
                         if (!met || key[k] < nearest) nearest = key[k], next = static_cast<unsigned>(k);
                     }
                     met |= 1u << k;
@@ -180,4 +211,14 @@ void packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Answ
             }
         }
     });
+}
+
+inline void closest_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<Hit> hits,
+                                 TraversalCounters* counters) {
+    packet_batch<ClosestHit>(tree, rays, hits, counters);
+}
+
+inline void any_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
+                             TraversalCounters* counters) {
+    packet_batch<AnyHit>(tree, rays, occluded, counters);
 }
