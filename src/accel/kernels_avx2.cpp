@@ -19,6 +19,7 @@ namespace wide {
 constexpr int kLanes = kBvhWidth;
 #include "simd/lanes.inl"
 #include "bvh/bvh_kernels.inl"
+#include "bvh/bvh_packet.inl"
 }  // namespace wide
 #undef CELLRT_SIMD_AVX2
 }  // namespace cellrt::detail::isa_avx2
@@ -29,7 +30,11 @@ constexpr int kLanes = kBvhWidth;
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx2() { return isa_avx2::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() { return isa_avx2::wide::bvh_kernels("avx2"); }
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() {
+    using namespace isa_avx2::wide;
+    static const BvhKernels k = bvh_kernel_table("avx2", &closest_packet_batch, &any_packet_batch, kPacketRays);
+    return k;
+}
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx2() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() { return bvh_kernels_portable(); }

@@ -35,13 +35,7 @@ using wide::test_leaf;
 using wide::traverse_bvh_from;
 #include "bvh/bvh_packet.inl"
 inline const BvhKernels& bvh_kernels() {
-    static const BvhKernels k = [] {
-        BvhKernels with16 = wide::bvh_kernels("avx512");
-        with16.packet_closest = &closest_packet_batch;
-        with16.packet_any = &any_packet_batch;
-        with16.packet_rays = kPacketRays;
-        return with16;
-    }();
+    static const BvhKernels k = wide::bvh_kernel_table("avx512", &closest_packet_batch, &any_packet_batch, kPacketRays);
     return k;
 }
 #undef CELLRT_SIMD_AVX512

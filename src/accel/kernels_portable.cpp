@@ -16,8 +16,13 @@ namespace wide {
 constexpr int kLanes = kBvhWidth;
 #include "simd/lanes.inl"
 #include "bvh/bvh_kernels.inl"
+#include "bvh/bvh_packet.inl"
 }  // namespace wide
 }  // namespace cellrt::detail::isa_portable
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_portable() { return isa_portable::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_portable() { return isa_portable::wide::bvh_kernels("portable"); }
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_portable() {
+    using namespace isa_portable::wide;
+    static const BvhKernels k = bvh_kernel_table("portable", &closest_packet_batch, &any_packet_batch, kPacketRays);
+    return k;
+}

@@ -24,6 +24,7 @@ namespace wide {
 constexpr int kLanes = kBvhWidth;
 #include "simd/lanes.inl"
 #include "bvh/bvh_kernels.inl"
+#include "bvh/bvh_packet.inl"
 }  // namespace wide
 #undef CELLRT_SIMD_SSE
 }  // namespace cellrt::detail::isa_sse
@@ -34,7 +35,11 @@ constexpr int kLanes = kBvhWidth;
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_sse() { return isa_sse::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() { return isa_sse::wide::bvh_kernels("sse"); }
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() {
+    using namespace isa_sse::wide;
+    static const BvhKernels k = bvh_kernel_table("sse", &closest_packet_batch, &any_packet_batch, kPacketRays);
+    return k;
+}
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_sse() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() { return bvh_kernels_portable(); }

@@ -6,8 +6,9 @@
 // tasks; the same tree at any count). Traversals: "paired" (single rays, two walks at a time,
 // bvh_kernels.inl; the default), "wide" (single rays, one walk), "stream" (the batch's rays down the tree
 // together, bvh_stream.inl: each node read once per stream) and "packet" (eight consecutive rays of
-// the batch together, sixteen with AVX-512, one per lane, bvh_packet.inl). The kernels come from the registry, compiled for the instruction set
-// AccelConfig::simd names (registry: bvh_kernels_for; nodes and leaves in eight lanes in every set).
+// the batch together, sixteen with AVX-512, one per lane, bvh_packet.inl). The kernels come from the
+// registry, compiled for the instruction set AccelConfig::simd names (registry: bvh_kernels_for;
+// nodes and leaves in eight lanes in every set).
 #pragma once
 
 #include <memory>

@@ -1,7 +1,7 @@
 // The wide BVH's kernels as the registry hands them to the accelerator: one table per instruction
 // set. The kernels themselves (bvh_kernels.inl) are compiled in each set's unit of the registry
 // (accel/kernels_<isa>.cpp), beside the SIMD packet kernels, in eight lanes whatever that set's
-// packet width.
+// packet width; only the BVH's packets hold sixteen rays with AVX-512 (bvh_packet.inl).
 #pragma once
 
 #include <algorithm>

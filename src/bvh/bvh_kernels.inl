@@ -523,11 +523,12 @@ inline void prefetch_child(const BvhNode* nodes, const BvhLeaf* leaves, std::uin
 }
 
 #include "bvh/bvh_stream.inl"
-#include "bvh/bvh_packet.inl"
 
-inline const BvhKernels& bvh_kernels(const char* isa) {
-    static const BvhKernels k{&closest_batch,        &any_batch,        &closest_stream_batch, &any_stream_batch,
-                              &closest_packet_batch, &any_packet_batch, kPacketRays, &closest_paired_batch,
-                              &any_paired_batch,     isa};
-    return k;
+// This namespace's kernels as the registry's table, with the packets' entry points and width from
+// the namespace that includes bvh_packet.inl: this one (eight rays) or, with AVX-512, the unit's
+// sixteen-lane one.
+inline BvhKernels bvh_kernel_table(const char* isa, decltype(BvhKernels::packet_closest) packet_closest,
+                                   decltype(BvhKernels::packet_any) packet_any, int packet_rays) {
+    return {&closest_batch, &any_batch,   &closest_stream_batch, &any_stream_batch,  packet_closest,
+            packet_any,     packet_rays,  &closest_paired_batch, &any_paired_batch,  isa};
 }

@@ -1,6 +1,6 @@
 // Packets of rays over the wide BVH (issue 18; after Wald, Benthin, Boulos 2008, "Getting Rid of
-// Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8/16): eight (or sixteen,
-// below) consecutive rays of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
+// Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8/16): eight (or
+// sixteen, below) consecutive rays of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
 // against the packet's rays at once, giving the rays that meet it; the packet goes on to the children
 // some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
 // query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top).
@@ -17,8 +17,8 @@
 // past the ray's own entry, where its own kernel drops the branch too. The hit rule picks the same
 // answer whatever the order, so the answers are brute force's.
 //
-// The packet is as wide as the namespace it is included in: after bvh_kernels.inl in the wide BVH's
-// namespace of eight lanes, or (AVX-512) in its instruction set's namespace of sixteen lanes, with
+// The packet is as wide as the namespace it is included in, after bvh_kernels.inl: the wide BVH's
+// namespace of eight lanes, or (AVX-512) its instruction set's namespace of sixteen lanes, with
 // the wide BVH's node, leaf and single-ray names brought in by using-declarations: sixteen rays
 // share each node's fetch and loop, while a child's box and a leaf's triangles are still tested in
 // eight lanes (Embree's rtcIntersect16 over its BVH8 likewise).
