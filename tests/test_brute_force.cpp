@@ -37,27 +37,33 @@ TEST(BruteForce, StoredSuiteRecomputesStaleLimitedRays) {
     few.axis_parallel = 120;
     few.planes = 200;
     const test::ReferenceAnswers fresh = test::reference_suite(scene.triangles, few);
-    const std::string dir = ::testing::TempDir() + "cellrt_stale_cache_" + std::to_string(::getpid());
-    const char* previous = std::getenv("CELLRT_TEST_CACHE");
-    const std::string saved = previous ? previous : "";
-    ASSERT_EQ(::setenv("CELLRT_TEST_CACHE", dir.c_str(), 1), 0);
+    const std::vector<Ray> base = test::RaySuite(scene.triangles, few).rays();
+    // A cache folder of this test's own, and the caller's restored however the test ends.
+    struct CacheFolder {
+        std::string dir = ::testing::TempDir() + "cellrt_stale_cache_" + std::to_string(::getpid());
+        const char* previous = std::getenv("CELLRT_TEST_CACHE");
+        std::string saved = previous ? previous : "";
+        CacheFolder() { ::setenv("CELLRT_TEST_CACHE", dir.c_str(), 1); }
+        ~CacheFolder() {
+            std::filesystem::remove_all(dir);
+            if (previous) ::setenv("CELLRT_TEST_CACHE", saved.c_str(), 1);
+            else ::unsetenv("CELLRT_TEST_CACHE");
+        }
+    } folder;
     const test::ReferenceAnswers first = test::stored_suite(scene.triangles, few);
     ASSERT_EQ(first.rays.size(), fresh.rays.size());
+    ASSERT_GT(first.rays.size(), base.size());  // the last ray is a limited copy
 
-    const std::string path =
-        test::stored_answers_path(scene.triangles, test::RaySuite(scene.triangles, few).rays());
     test::ReferenceAnswers stale = first;
     const std::size_t last = stale.rays.size() - 1;
-    ASSERT_NE(last % 97, 0u);
+    ASSERT_NE(last % 97, 0u);  // not in the sample that is recomputed
     stale.rays[last].tfar = std::nextafter(stale.rays[last].tfar, 0.f);
-    test::detail::write_reference(path, stale);
+    ASSERT_NE(stale.rays[last].tfar, first.rays[last].tfar);
+    test::detail::write_reference(test::stored_answers_path(scene.triangles, base), stale);
 
     const test::ReferenceAnswers again = test::stored_suite(scene.triangles, few);
     ASSERT_EQ(again.rays.size(), fresh.rays.size());
     EXPECT_EQ(std::memcmp(again.rays.data(), fresh.rays.data(), fresh.rays.size() * sizeof(Ray)), 0);
-    std::filesystem::remove_all(dir);
-    if (previous) ::setenv("CELLRT_TEST_CACHE", saved.c_str(), 1);
-    else ::unsetenv("CELLRT_TEST_CACHE");
 }
 
 TEST(BruteForce, RejectsUnknownParameterAndTraversal) {
