@@ -438,12 +438,12 @@ TEST(Bvh, EveryTraversalInBatchesOfAnySizeMatchesBruteForce) {
     }
 }
 
-// The paired walks, the streams and the packets set their rays up eight at a time in lanes
+// The paired walks, the streams and the packets set their rays up eight (AVX-512's packets sixteen) at a time in lanes
 // (bvh_kernels.inl, prepare_rays and WatertightLanes), which must give each ray the bits of its own
 // set-up: the watertight test's axes where two or three direction components tie in magnitude
 // (max_axis takes the first), the swap where the dominant component is negative, the signs of -0 and
 // +0 components (the box test's planes). Rays with every such direction, aimed at points of the
-// scene, against brute force, in batches that leave partial groups of eight.
+// scene, against brute force, in batches that leave partial groups of eight and of sixteen.
 TEST(Bvh, RaysSetUpInLanesKeepTiesAndSignsOfTheirDirections) {
     const Scene& scene = test::cached_scene("builtin:spheres?tris=3000");
     const float parts[] = {-1.f, -0.f, 0.f, 1.f, 0.5f};
@@ -719,6 +719,33 @@ TEST(Routed, PickerChoosesAmongThreePaths) {
     EXPECT_FALSE(half.far(2, 1));
 }
 
+// A path left out of a kind (the router's study-tree packets on incoherent batches) is neither
+// chosen nor timed, however cheap it would be: the others learn in runs of their own length.
+TEST(Routed, PickerLeavesOutAPath) {
+    using detail::RoutePicker;
+    RoutePicker picker(4, 1u);
+    EXPECT_FALSE(picker.takes_part(0));
+    EXPECT_TRUE(picker.takes_part(1) && picker.takes_part(2) && picker.takes_part(3));
+    EXPECT_EQ(picker.run_length(), 3 * RoutePicker::kPerPath * RoutePicker::kRounds);
+    for (std::uint64_t i = 0; i < RoutePicker::kPrior; ++i) EXPECT_EQ(picker.pick(1).path, 1);  // the prior
+    PickerRun run{picker, {0.5, 2.0, 3.0, 1.5}};  // path 0 would be the cheapest
+    const auto learning = static_cast<int>(RoutePicker::kLearnRuns * picker.run_length());
+    EXPECT_EQ(run.take(learning, 1), learning / static_cast<int>(RoutePicker::kPerPath) *
+                                         static_cast<int>(RoutePicker::kPerPath - 1));
+    EXPECT_EQ(run.paths_seen[0], 0);
+    EXPECT_EQ(run.paths_seen[1], run.paths_seen[2]);
+    EXPECT_EQ(run.paths_seen[2], run.paths_seen[3]);
+    run.take(20000, 1);
+    EXPECT_EQ(run.paths_seen[0], 0);
+    EXPECT_EQ(picker.samples(0), 0u);
+    EXPECT_EQ(picker.fastest(1), 3);
+    // A mask that would leave fewer than two paths, or names paths not held, leaves none out.
+    const RoutePicker two(2, 1u), three(3, 3u);
+    EXPECT_TRUE(two.takes_part(0) && three.takes_part(0) && three.takes_part(1));
+    EXPECT_EQ(three.run_length(), 3 * RoutePicker::kPerPath * RoutePicker::kRounds);
+    EXPECT_EQ(RoutePicker(2, 4u).run_length(), 2 * RoutePicker::kPerPath * RoutePicker::kRounds);
+}
+
 // A frame's tiles in order, where a tile on the object costs ten times one of background: the
 // object fills the middle columns of rows 4 to 11 of 16 x 16 tiles. The packets take 1.0 per ray,
 // the single rays 1.3, the streams 1.25, the BVH's packets 1.15. Every path is timed on tiles of the same stretches, so the
@@ -896,8 +923,9 @@ TEST(Routed, BvhPacketsRouteHoldsOneTree) {
     EXPECT_EQ(one.simd_lanes, 0);
 }
 
-// While it learns, the route gives runs of batches to each of its paths (four; three when the
-// BVH's packets are its packets), with the same answers, and the work counted is one tracing per
+// While it learns, the route gives runs of the suite's batches (incoherent: random directions) to
+// each of its paths taking part (the BVH's three; a study tree's packets take no part in
+// incoherent batches, RoutePicker), with the same answers, and the work counted is one tracing per
 // ray whichever path answered.
 class RoutedPaths : public ::testing::TestWithParam<std::pair<std::string, std::vector<std::string>>> {};
 
@@ -919,19 +947,25 @@ TEST_P(RoutedPaths, StreamedBatchesAnswerAsBruteForce) {
         EXPECT_EQ(occluded, ref.occluded);
         EXPECT_EQ(counters.rays, ref.rays.size());
     }
-    // Each path answered some of them: "closest packets P paired S stream T bvh-packets B; any ...".
+    // Each path taking part answered some of them, the study tree's packets none: "closest packets
+    // P paired S stream T bvh-packets B; any ...", for closest and any hits.
     const std::string routes = routed->stats().setting("routed").value_or("");
-    EXPECT_EQ(routes.find(" bvh-packets ") != std::string::npos, names.size() == 4) << routes;
-    for (const std::string& name : names) {
+    const bool study_packets = spec == "auto";
+    EXPECT_EQ(routes.find(" bvh-packets ") != std::string::npos, study_packets) << routes;
+    for (const std::string& name : {"packets", "paired", "stream", "bvh-packets"}) {
+        if (name == "bvh-packets" && !study_packets) continue;
         const std::string path = " " + name + " ";
-        const std::size_t at = routes.find(path);
-        ASSERT_NE(at, std::string::npos) << routes;
-        EXPECT_GT(std::stod(routes.substr(at + path.size())), 0.0) << path << "in: " << routes;
+        for (std::size_t at = routes.find(path), seen = 0; seen < 2; at = routes.find(path, at + 1), ++seen) {
+            ASSERT_NE(at, std::string::npos) << path << "in: " << routes;
+            const double share = std::stod(routes.substr(at + path.size()));
+            if (std::ranges::find(names, name) != names.end()) EXPECT_GT(share, 0.0) << path << "in: " << routes;
+            else EXPECT_EQ(share, 0.0) << path << "in: " << routes;
+        }
     }
 }
 
 INSTANTIATE_TEST_SUITE_P(Routed, RoutedPaths,
-                         ::testing::Values(std::pair{std::string("auto"), std::vector<std::string>{"packets", "paired", "stream", "bvh-packets"}},
+                         ::testing::Values(std::pair{std::string("auto"), std::vector<std::string>{"paired", "stream", "bvh-packets"}},
                                            std::pair{std::string("auto@packets=bvh"), std::vector<std::string>{"packets", "paired", "stream"}}),
                          [](const auto& info) { return info.index == 0 ? std::string("KdPackets") : std::string("BvhPackets"); });
 

@@ -48,7 +48,8 @@ public:
     // otherwise (bvh_with_traversal) after them.
     RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
         : paths_(std::move(paths)), threshold_(threshold), packets_(std::move(packets)), measured_(measured),
-          pickers_{RoutePicker(count()), RoutePicker(count()), RoutePicker(count()), RoutePicker(count())} {}
+          pickers_{RoutePicker(count()), RoutePicker(count(), incoherent_left_out()), RoutePicker(count()),
+                   RoutePicker(count(), incoherent_left_out())} {}
 
     AccelStats stats() const override {
         const AccelStats c = paths_[0].accel->stats();
@@ -148,6 +149,7 @@ private:
             out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) +
                    " batches, rays hitting none/some/all " + mix + "), ns per ray";
             for (int p = 0; p < count(); ++p) {
+                if (!picker.takes_part(p)) continue;
                 char buf[48];
                 std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p));
                 out += buf;
@@ -160,6 +162,9 @@ private:
     }
 
     int count() const { return static_cast<int>(paths_.size()); }
+    // The paths the incoherent batches' pickers leave out: a study tree's packets (RoutePicker),
+    // where at least two of the BVH's paths are left to choose between.
+    unsigned incoherent_left_out() const { return !paths_[0].view && count() >= 3 ? 1u : 0u; }
 
     std::vector<RoutePath> paths_;
     float threshold_;

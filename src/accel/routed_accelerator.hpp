@@ -3,8 +3,8 @@
 // square tiles of primary rays and shadow rays toward one light) and the wide BVH (fastest on
 // incoherent batches: diffuse bounces, AO, random queries), the latter traced as single rays two at a
 // time (bvh:paired), as a stream (unless streams=off; bvh_stream.inl: the batch's rays down the tree
-// together) or in packets of eight rays, sixteen on AVX-512 (unless bvh_packets=off; bvh_packet.inl). With packets=bvh
-// the BVH's own packets are the coherent batches' path: one tree, one build. It routes each batch by
+// together) or in packets of eight rays, sixteen on AVX-512 (unless bvh_packets=off; bvh_packet.inl).
+// With packets=bvh the BVH's own packets are the coherent batches' path: one tree, one build. It routes each batch by
 // its coherence and by the time per ray each path has taken on batches of its kind (docs/BVH.md,
 // docs/INCOHERENT.md).
 // Every path returns the brute-force hits, so the answers, and images, do not depend on the route.
@@ -64,7 +64,7 @@ const std::vector<std::string>& routed_traversals();
 // every ray hits) the cost is the plain time per ray.
 //
 // The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
-// Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path; then
+// Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path taking part; then
 // the fastest path takes every run but one in kSample, chosen by a hash of the run's number (not
 // every n-th, which would sample the same column of a frame's tiles); that run is timed with the
 // fastest and every path within kFar of it, and a path that costs more than kFar times the fastest
@@ -72,6 +72,14 @@ const std::vector<std::string>& routed_traversals();
 // of each other are compared often, on the same stretches. Times are the thread's CPU time, so a
 // batch whose thread the system preempted does not count the other threads' time. Sums are atomics:
 // any number of threads route and record at once, and a race only blurs a figure.
+//
+// A study tree's packets take no part in the incoherent batches' runs (the router leaves them out,
+// RoutePicker's `left_out`): timed there, on every scene and ray kind measured, they cost 1.9 to 4.3
+// times the fastest path, and their batches, on another tree than the BVH's, pushed its nodes out of
+// the caches for the batches after them. The BVH's packets, which a warm cache helps most, were then
+// timed at 121 ns a ray on Sibenik's AO rays where they take 104 alone, behind the streams (118),
+// which read each node once per batch; without the kd-tree's runs they were timed at 89 to 95
+// (docs/INCOHERENT.md, "Nineteenth round").
 class RoutePicker {
 public:
     static constexpr std::uint64_t kPrior = 8, kRounds = 3, kPerPath = 3, kLearnRuns = 4, kSample = 16, kSampleFar = 64;
@@ -80,11 +88,21 @@ public:
     // Classes of a batch's hit fraction: none, some, all.
     static constexpr int kStrata = 3;
 
-    explicit RoutePicker(int paths = 2) : paths_(paths < 2 ? 2 : (paths > kMaxPaths ? kMaxPaths : paths)) {}
+    // `left_out`: the paths (bits) never chosen nor timed, for a kind of batch that some path is
+    // known not to suit (the router's incoherent batches and a study tree's packets: below); the
+    // prior given to pick() must take part. A mask that would leave fewer than two paths is ignored.
+    explicit RoutePicker(int paths = 2, unsigned left_out = 0)
+        : paths_(paths < 2 ? 2 : (paths > kMaxPaths ? kMaxPaths : paths)),
+          left_out_(usable(paths_, left_out & ((1u << paths_) - 1u))) {}
 
     int paths() const { return paths_; }
-    // Batches per run: in each round, kPerPath per path.
-    std::uint64_t run_length() const { return kPerPath * kRounds * static_cast<std::uint64_t>(paths_); }
+    bool takes_part(int path) const { return !(left_out_ >> path & 1u); }
+    // Batches per run: in each round, kPerPath per path taking part.
+    std::uint64_t run_length() const {
+        std::uint64_t n = 0;
+        for (int p = 0; p < paths_; ++p) n += takes_part(p) ? 1 : 0;
+        return kPerPath * kRounds * n;
+    }
     // The batches counted for `path`, their time in seconds and their rays.
     std::uint64_t samples(int path) const { return samples_[path].load(std::memory_order_relaxed); }
     double seconds(int path) const { return sum(seconds_[path]); }
@@ -148,13 +166,14 @@ public:
         int in_run[kMaxPaths];
         int k = 0;
         if (run < kLearnRuns) {
-            for (int p = 0; p < paths_; ++p) in_run[k++] = p;
+            for (int p = 0; p < paths_; ++p)
+                if (takes_part(p)) in_run[k++] = p;
         } else {
             const int fast = fastest(prior);
             if (h % kSample != 0) return {fast, false};
             const bool far_ones_join = (h >> 32) % (kSampleFar / kSample) == 0;
             for (int p = 0; p < paths_; ++p)
-                if (p == fast || !far(p, fast) || far_ones_join) in_run[k++] = p;
+                if (takes_part(p) && (p == fast || !far(p, fast) || far_ones_join)) in_run[k++] = p;
         }
         // The run's order: a rotation drawn by the hash, so that no path keeps the same columns of a
         // frame's tiles from run to run. A round is kPerPath * k batches; with fewer paths than the
@@ -189,6 +208,9 @@ public:
     }
 
 private:
+    static unsigned usable(int paths, unsigned left_out) {
+        return paths - __builtin_popcount(left_out) >= 2 ? left_out : 0u;
+    }
     // SplitMix64's finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators",
     // OOPSLA 2014): independent-looking bits for consecutive run numbers.
     static std::uint64_t mix(std::uint64_t x) {
@@ -209,6 +231,7 @@ private:
     }
 
     int paths_;
+    unsigned left_out_;
     std::atomic<std::uint64_t> batches_{0};
     std::atomic<std::uint64_t> samples_[kMaxPaths]{};
     // Per path and class of hit fraction: the counted batches' seconds and rays.
