@@ -59,6 +59,11 @@ V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
     (V, [[0, 1, 3]], r"faces\[0, 2\] = 3 is out of range for 3 vertices"),
     (V, [[0, 1, 2], [0, -1, 2]], r"faces\[1, 1\] = -1 is out of range for 3 vertices"),
     (V, np.array([[0, 1, 2**64 - 1]], np.uint64), r"faces\[0, 2\] = 18446744073709551615 is out of range"),
+    (V, [[0, 1, 2**70]], r"faces\[0, 2\] = 1180591620717411303424 is out of range for 3 vertices"),
+    (V, [[0, 1, 2], [-2**64, 1, 2]], r"faces\[1, 0\] = -18446744073709551616 is out of range for 3 vertices"),
+    (V, np.array([[0, 1, "2"]], object), r"faces\[0, 2\] = '2' is not an integer"),
+    (V, np.array([[0, True, 2]], object), r"faces\[0, 1\] = True is not an integer"),
+    (V, np.array([[0, 1.0, 2]], object), r"faces\[0, 1\] = 1.0 is not an integer"),
     (V, np.array([[0, 1, 2]], np.float32), "faces must hold integers, got dtype float32"),
     (V, np.array([[0, 1, 2]], bool), "faces must hold integers, got dtype bool"),
     (V, [[0, 1]], r"faces must have shape \(M, 3\), got \(1, 2\)"),
@@ -70,6 +75,11 @@ V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
 ])
 def test_bad_indexed_mesh(vertices, faces, match):
     refused(match, cellrt.Accelerator, vertices, faces)
+
+
+def test_object_faces_in_range_are_accepted():
+    faces = np.array([[0, np.int64(1), 2]], object)
+    assert cellrt.Accelerator(V, faces).stats.triangles == 1
 
 
 @pytest.mark.parametrize("kwargs,match", [
