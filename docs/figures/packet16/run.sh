@@ -29,3 +29,15 @@ for rays in ao diffuse random frame; do
     --configs embree:packet16 auto
 done
 bench/incoherent_state.sh $D/state_route $ROUTE_NEW
+# Whole frames, one and two workers, two runs of seven repeats each (scaling_*_{1,2}.json, scaling.md),
+# with the route's binary (build/bench/cellrt_scaling of the same commit):
+S=$(dirname "$ROUTE_NEW")/cellrt_scaling
+for r in 1 2; do
+  for s in ao diffuse; do
+    $S --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+      --configs embree:single embree:packet8 embree:packet16 auto bvh:packet --dispatch pull --packets 16 \
+      --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/scaling_${s}_$r.json
+  done
+done
+python3 $D/scaling_table.py $D/scaling_ao_1.json $D/scaling_ao_2.json $D/scaling_diffuse_1.json \
+  $D/scaling_diffuse_2.json > $D/scaling.md
