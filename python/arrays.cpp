@@ -109,31 +109,37 @@ Bound ray_bound(py::handle object, const std::string& name, std::size_t rays) {
 }
 
 // Faces that numpy could hold only as Python objects (integers past 64 bits, or values of mixed
-// types): the first that is not an integer (bool excluded, anything with __index__ included) or
-// lies outside [0, vertices) is named, as for an integer array.
-void check_object_faces(const py::array& f, std::size_t vertices) {
+// types), as indices: each must be an integer (Python's or numpy's bools excluded; anything
+// operator.index takes included, which is the value used) in [0, vertices), or the first that is
+// not is named, as for an integer array.
+std::vector<std::int64_t> object_face_indices(const py::array& f, std::size_t vertices) {
     const py::list rows = f.attr("tolist")();
     const py::object index = py::module_::import("operator").attr("index");
+    const py::object numpy_bool = numpy().attr("bool_");
     const py::int_ zero(0), count(vertices);
+    std::vector<std::int64_t> out;
+    out.reserve(3 * rows.size());
     for (std::size_t t = 0; t < rows.size(); ++t) {
         const py::list row = rows[t];
         for (std::size_t c = 0; c < 3; ++c) {
             const py::object x = row[c];
-            const std::string at = "faces[" + std::to_string(t) + ", " + std::to_string(c) + "] = ";
+            const auto at = [&] { return "faces[" + std::to_string(t) + ", " + std::to_string(c) + "] = "; };
             py::object k;
-            if (!py::isinstance<py::bool_>(x)) {
+            if (!py::isinstance<py::bool_>(x) && !py::isinstance(x, numpy_bool)) {
                 try {
                     k = index(x);
                 } catch (py::error_already_set& e) {
-                    if (!e.matches(PyExc_TypeError)) throw;
+                    if (e.matches(PyExc_MemoryError)) throw;
                 }
             }
-            if (!k) throw py::value_error(at + py::repr(x).cast<std::string>() + " is not an integer");
+            if (!k) throw py::value_error(at() + py::repr(x).cast<std::string>() + " is not an integer");
             if (k < zero || k >= count)
-                throw py::value_error(at + py::str(k).cast<std::string>() + " is out of range for " +
+                throw py::value_error(at() + py::str(k).cast<std::string>() + " is out of range for " +
                                       std::to_string(vertices) + " vertices");
+            out.push_back(k.cast<std::int64_t>());
         }
     }
+    return out;
 }
 
 std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
@@ -146,13 +152,16 @@ std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
     if (f.ndim() != 2 || f.shape(1) != 3)
         throw py::value_error("faces must have shape (M, 3), got " + shape_of(f));
     const char kind = f.dtype().kind();
-    if (kind == 'O') check_object_faces(f, v.rows);
-    else if (kind != 'i' && kind != 'u') throw py::value_error("faces must hold integers, got dtype " + dtype_of(f));
+    if (kind != 'i' && kind != 'u' && kind != 'O')
+        throw py::value_error("faces must hold integers, got dtype " + dtype_of(f));
     const std::size_t m = static_cast<std::size_t>(f.shape(0));
     check_triangle_count(m, "faces");
     // uint64 indices beyond int64 wrap to negative values, which the range check refuses.
-    const py::array idx = required(f, "int64", "faces");
-    const auto* index = static_cast<const std::int64_t*>(idx.data());
+    std::vector<std::int64_t> objects;
+    py::array idx;
+    if (kind == 'O') objects = object_face_indices(f, v.rows);
+    else idx = required(f, "int64", "faces");
+    const auto* index = kind == 'O' ? objects.data() : static_cast<const std::int64_t*>(idx.data());
     std::vector<Triangle> tris(m);
     for (std::size_t t = 0; t < m; ++t) {
         Vec3* corner = &tris[t].v0;

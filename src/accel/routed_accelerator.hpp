@@ -74,7 +74,7 @@ const std::vector<std::string>& routed_traversals();
 // any number of threads route and record at once, and a race only blurs a figure.
 //
 // A study tree's packets take no part in the incoherent batches' runs (the router leaves them out,
-// RoutePicker's `left_out`): timed there, on every scene and ray kind measured, they cost 1.9 to 4.3
+// RoutePicker's `left_out`): timed there, on every scene and ray kind measured, they cost 1.8 to 4.1
 // times the fastest path, and their batches, on another tree than the BVH's, pushed its nodes out of
 // the caches for the batches after them. The BVH's packets, which a warm cache helps most, were then
 // timed at 121 ns a ray on Sibenik's AO rays where they take 104 alone, behind the streams (118),

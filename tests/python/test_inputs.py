@@ -55,6 +55,23 @@ def test_bad_triangles(triangles, match):
 V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
 
 
+class BadIndex:
+    """An object whose __index__ raises something other than TypeError."""
+
+    def __index__(self):
+        raise OverflowError("no index")
+
+    def __repr__(self):
+        return "<bad index>"
+
+
+class TwoFaced(int):
+    """An int whose __int__ differs from its __index__: the index is the value used."""
+
+    def __int__(self):
+        return 10**30
+
+
 @pytest.mark.parametrize("vertices,faces,match", [
     (V, [[0, 1, 3]], r"faces\[0, 2\] = 3 is out of range for 3 vertices"),
     (V, [[0, 1, 2], [0, -1, 2]], r"faces\[1, 1\] = -1 is out of range for 3 vertices"),
@@ -64,6 +81,9 @@ V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
     (V, np.array([[0, 1, "2"]], object), r"faces\[0, 2\] = '2' is not an integer"),
     (V, np.array([[0, True, 2]], object), r"faces\[0, 1\] = True is not an integer"),
     (V, np.array([[0, 1.0, 2]], object), r"faces\[0, 1\] = 1.0 is not an integer"),
+    (V, np.array([[0, np.True_, 2]], object), r"faces\[0, 1\] = (np\.)?True_? is not an integer"),
+    (V, np.array([[0, 1, np.uint64(2**64 - 1)]], object), r"faces\[0, 2\] = 18446744073709551615 is out of range"),
+    (V, np.array([[0, 1, BadIndex()]], object), r"faces\[0, 2\] = <bad index> is not an integer"),
     (V, np.array([[0, 1, 2]], np.float32), "faces must hold integers, got dtype float32"),
     (V, np.array([[0, 1, 2]], bool), "faces must hold integers, got dtype bool"),
     (V, [[0, 1]], r"faces must have shape \(M, 3\), got \(1, 2\)"),
@@ -80,6 +100,8 @@ def test_bad_indexed_mesh(vertices, faces, match):
 def test_object_faces_in_range_are_accepted():
     faces = np.array([[0, np.int64(1), 2]], object)
     assert cellrt.Accelerator(V, faces).stats.triangles == 1
+    two_faced = np.array([[0, TwoFaced(1), 2]], object)
+    assert cellrt.Accelerator(V, two_faced).stats.triangles == 1
 
 
 @pytest.mark.parametrize("kwargs,match", [

@@ -11,9 +11,6 @@ for rays in ao frame diffuse; do
 done
 python3 $D/ratio.py > $D/ratio.md
 bench/incoherent_state.sh $D/state $NEW
-# The same binary, eight rays a packet (AVX2 kernels) against sixteen (AVX-512 kernels), in one run:
-$NEW --scenes-dir ../shared/scenes --scenes sponza sibenik --size 256x256 --repeats 5 --builds 1 --rays ao \
-  --clock cpu --configs embree:packet8 embree:packet16 bvh:packet+avx2 bvh:packet+avx512
 # The route leaving the kd-tree's packets out of incoherent batches (route_*.json, state_route/):
 # ROUTE_OLD, the binary of the packets' commit, against ROUTE_NEW, the route's; given as the third
 # and fourth arguments.
@@ -41,3 +38,10 @@ for r in 1 2; do
 done
 python3 $D/scaling_table.py $D/scaling_ao_1.json $D/scaling_ao_2.json $D/scaling_diffuse_1.json \
   $D/scaling_diffuse_2.json > $D/scaling.md
+# Eight rays a packet (AVX2's kernels) against sixteen (AVX-512's) in the same binary, two runs
+# (width_ao_*.json), the route's binary:
+for r in 1 2; do
+  $ROUTE_NEW --scenes-dir ../shared/scenes --scenes sponza sibenik --size 256x256 --repeats 5 --builds 1 \
+    --rays ao --clock cpu --configs embree:packet8 embree:packet16 bvh:packet+avx2 bvh:packet+avx512 \
+    --json $D/width_ao_$r.json
+done
