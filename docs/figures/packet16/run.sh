@@ -45,3 +45,10 @@ for r in 1 2; do
     --rays ao --clock cpu --configs embree:packet8 embree:packet16 bvh:packet+avx2 bvh:packet+avx512 \
     --json $D/width_ao_$r.json
 done
+# Direct frames (the study's shading), one worker: the kd-tree's packets against the BVH's sixteen
+# (direct_*.json):
+for r in 1 2; do
+  $S --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:packet16 auto auto@packets=bvh kd+auto bvh:packet --dispatch pull --packets 16 \
+    --workers 1 --repeats 7 --size 384x384 --shading direct --json $D/direct_$r.json
+done
