@@ -30,11 +30,7 @@ constexpr int kLanes = kBvhWidth;
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx2() { return isa_avx2::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() {
-    using namespace isa_avx2::wide;
-    static const BvhKernels k = bvh_kernel_table("avx2", &closest_packet_batch, &any_packet_batch, kPacketRays);
-    return k;
-}
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() { return isa_avx2::wide::bvh_kernels("avx2"); }
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx2() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx2() { return bvh_kernels_portable(); }

@@ -24,6 +24,8 @@ constexpr int kLanes = kBvhWidth;
 // The wide BVH's packets of sixteen rays, one per lane of this set (bvh_packet.inl), over its
 // eight-lane nodes and leaves.
 using wide::BoxRay;
+using wide::bvh_kernel_table;
+using wide::horizontal_min;
 using wide::kBvhStackSize;
 using wide::kBvhStackSlack;
 using wide::LeafRay;
@@ -34,10 +36,6 @@ using wide::prefetch_child;
 using wide::test_leaf;
 using wide::traverse_bvh_from;
 #include "bvh/bvh_packet.inl"
-inline const BvhKernels& bvh_kernels() {
-    static const BvhKernels k = wide::bvh_kernel_table("avx512", &closest_packet_batch, &any_packet_batch, kPacketRays);
-    return k;
-}
 #undef CELLRT_SIMD_AVX512
 }  // namespace cellrt::detail::isa_avx512
 #if defined(__clang__)
@@ -47,7 +45,7 @@ inline const BvhKernels& bvh_kernels() {
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx512() { return isa_avx512::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return isa_avx512::bvh_kernels(); }
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return isa_avx512::bvh_kernels("avx512"); }
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_avx512() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_avx512() { return bvh_kernels_portable(); }

@@ -21,8 +21,4 @@ constexpr int kLanes = kBvhWidth;
 }  // namespace cellrt::detail::isa_portable
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_portable() { return isa_portable::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_portable() {
-    using namespace isa_portable::wide;
-    static const BvhKernels k = bvh_kernel_table("portable", &closest_packet_batch, &any_packet_batch, kPacketRays);
-    return k;
-}
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_portable() { return isa_portable::wide::bvh_kernels("portable"); }

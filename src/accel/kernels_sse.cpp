@@ -35,11 +35,7 @@ constexpr int kLanes = kBvhWidth;
 #endif
 
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_sse() { return isa_sse::kernels(); }
-const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() {
-    using namespace isa_sse::wide;
-    static const BvhKernels k = bvh_kernel_table("sse", &closest_packet_batch, &any_packet_batch, kPacketRays);
-    return k;
-}
+const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() { return isa_sse::wide::bvh_kernels("sse"); }
 #else
 const cellrt::detail::PacketKernels& cellrt::detail::packet_kernels_sse() { return packet_kernels_portable(); }
 const cellrt::detail::BvhKernels& cellrt::detail::bvh_kernels_sse() { return bvh_kernels_portable(); }

@@ -4,9 +4,9 @@
 // incoherent batches: diffuse bounces, AO, random queries), the latter traced as single rays two at a
 // time (bvh:paired), as a stream (unless streams=off; bvh_stream.inl: the batch's rays down the tree
 // together) or in packets of eight rays, sixteen on AVX-512 (unless bvh_packets=off; bvh_packet.inl).
-// With packets=bvh the BVH's own packets are the coherent batches' path: one tree, one build. It routes each batch by
-// its coherence and by the time per ray each path has taken on batches of its kind (docs/BVH.md,
-// docs/INCOHERENT.md).
+// With packets=bvh the BVH's own packets are the coherent batches' path: one tree, one build. It
+// routes each batch by its coherence and by the time per ray each path has taken on batches of its
+// kind (docs/BVH.md, docs/INCOHERENT.md).
 // Every path returns the brute-force hits, so the answers, and images, do not depend on the route.
 #pragma once
 
@@ -64,12 +64,12 @@ const std::vector<std::string>& routed_traversals();
 // every ray hits) the cost is the plain time per ray.
 //
 // The first kPrior batches of a kind go by coherence alone (the prior), so that a short run, a C or
-// Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path taking part; then
-// the fastest path takes every run but one in kSample, chosen by a hash of the run's number (not
-// every n-th, which would sample the same column of a frame's tiles); that run is timed with the
-// fastest and every path within kFar of it, and a path that costs more than kFar times the fastest
-// joins one in kSampleFar / kSample of them: a clear loser costs little, while two paths within kFar
-// of each other are compared often, on the same stretches. Times are the thread's CPU time, so a
+// Python caller's one query, pays nothing for the choice. Then kLearnRuns runs with every path
+// taking part; then the fastest path takes every run but one in kSample, chosen by a hash of the
+// run's number (not every n-th, which would sample the same column of a frame's tiles); that run is
+// timed with the fastest and every path within kFar of it, and a path that costs more than kFar
+// times the fastest joins one in kSampleFar / kSample of them: a clear loser costs little, while two
+// paths within kFar of each other are compared often, on the same stretches. Times are the thread's CPU time, so a
 // batch whose thread the system preempted does not count the other threads' time. Sums are atomics:
 // any number of threads route and record at once, and a race only blurs a figure.
 //
@@ -99,9 +99,7 @@ public:
     bool takes_part(int path) const { return !(left_out_ >> path & 1u); }
     // Batches per run: in each round, kPerPath per path taking part.
     std::uint64_t run_length() const {
-        std::uint64_t n = 0;
-        for (int p = 0; p < paths_; ++p) n += takes_part(p) ? 1 : 0;
-        return kPerPath * kRounds * n;
+        return kPerPath * kRounds * static_cast<std::uint64_t>(paths_ - __builtin_popcount(left_out_));
     }
     // The batches counted for `path`, their time in seconds and their rays.
     std::uint64_t samples(int path) const { return samples_[path].load(std::memory_order_relaxed); }

@@ -174,11 +174,6 @@ inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay
     return used & ~(negative & positive) & det_in_range_lanes(det);
 }
 
-// The lanes of a bit mask, as a lane mask.
-inline I met_mask(unsigned met) {
-    return (splat_i(static_cast<std::int32_t>(met)) & I{1, 2, 4, 8, 16, 32, 64, 128}) != 0;
-}
-
 // The smallest of eight lanes, floats or integers.
 template <class V>
 inline auto horizontal_min(V x) {

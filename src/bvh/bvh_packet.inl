@@ -1,6 +1,7 @@
 // Packets of rays over the wide BVH (issue 18; after Wald, Benthin, Boulos 2008, "Getting Rid of
 // Packets", whose BVH8 this is, and Embree's packet traversal, rtcIntersect8/16): eight (or
-// sixteen, below) consecutive rays of a batch go down the tree together, one ray per SIMD lane. At a node each child's box is tested
+// sixteen, below) consecutive rays of a batch go down the tree together, one ray per SIMD lane. At
+// a node each child's box is tested
 // against the packet's rays at once, giving the rays that meet it; the packet goes on to the children
 // some ray meets, each with those rays, the nearest first (by its rays' smallest entry; an any-hit
 // query: the first met), the others waiting on one stack (closest hit: sorted, the nearest on top).
@@ -29,27 +30,15 @@
 inline constexpr int kPacketRays = kLanes;
 static_assert(kPacketRays <= 32, "a packet's rays are the bits of an unsigned");
 
-// Lane i true where bit i of `rays` is set.
-inline I packet_lanes(unsigned rays) {
-    const I bit = []<std::size_t... L>(std::index_sequence<L...>) {
-        return I{static_cast<std::int32_t>(1u << L)...};
-    }(std::make_index_sequence<kPacketRays>());
-    return (splat_i(static_cast<std::int32_t>(rays)) & bit) != 0;
-}
-
-// The smallest of a packet's lanes (eight or sixteen): halves folded onto each other.
+// The smallest of a packet's lanes: sixteen folded onto eight, then horizontal_min's eight.
 template <class V>
 inline float packet_min(V x) {
-    const auto lesser = [](auto a, auto b) { return b < a ? b : a; };  // min_keep's choice
     if constexpr (sizeof(V) == 64) {
-        return packet_min(lesser(__builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7),
-                                 __builtin_shufflevector(x, x, 8, 9, 10, 11, 12, 13, 14, 15)));
+        const auto lo = __builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7);
+        const auto hi = __builtin_shufflevector(x, x, 8, 9, 10, 11, 12, 13, 14, 15);
+        return horizontal_min(hi < lo ? hi : lo);  // min_keep's choice
     } else {
-        static_assert(sizeof(V) == 32, "packets of eight or sixteen rays");
-        x = lesser(x, __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3));
-        x = lesser(x, __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5));
-        x = lesser(x, __builtin_shufflevector(x, x, 1, 0, 3, 2, 5, 4, 7, 6));
-        return x[0];
+        return horizontal_min(x);
     }
 }
 
@@ -136,7 +125,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
                     if constexpr (kAny) {
                         if (!met) next = static_cast<unsigned>(k);
                     } else {
-                        key[k] = packet_min(select(packet_lanes(m), entry, splat(kInfinity)));
+                        key[k] = packet_min(select(met_mask(m), entry, splat(kInfinity)));
                         if (!met || key[k] < nearest) nearest = key[k], next = static_cast<unsigned>(k);
                     }
                     met |= 1u << k;
@@ -221,4 +210,10 @@ inline void closest_packet_batch(const BvhTree& tree, std::span<const Ray> rays,
 inline void any_packet_batch(const BvhTree& tree, std::span<const Ray> rays, std::span<std::uint8_t> occluded,
                              TraversalCounters* counters) {
     packet_batch<AnyHit>(tree, rays, occluded, counters);
+}
+
+// The registry's table of the wide BVH's kernels with these packets (bvh_kernel_table).
+inline const BvhKernels& bvh_kernels(const char* isa) {
+    static const BvhKernels k = bvh_kernel_table(isa, &closest_packet_batch, &any_packet_batch, kPacketRays);
+    return k;
 }

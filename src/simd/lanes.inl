@@ -98,6 +98,14 @@ inline V lane_min_i(V a, V b) {
 inline F min_keep(F kept, F x) { return select(x < kept, x, kept); }
 inline F max_keep(F kept, F x) { return select(x > kept, x, kept); }
 
+// The lanes of a bit mask (bit i: lane i), as a lane mask.
+inline I met_mask(unsigned met) {
+    const I bit = []<std::size_t... L>(std::index_sequence<L...>) {
+        return I{static_cast<std::int32_t>(1u << L)...};
+    }(std::make_index_sequence<kLanes>());
+    return (splat_i(static_cast<std::int32_t>(met)) & bit) != 0;
+}
+
 // The lane-wise minimum by type, for code written once for floats and integers.
 inline F min_lanes(F a, F b) { return min_keep(a, b); }
 inline I min_lanes(I a, I b) { return lane_min_i(a, b); }
