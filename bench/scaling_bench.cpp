@@ -2,7 +2,7 @@
 // (512 x 512, primary rays and those their --shading casts, by default the study's one shadow ray per
 // hit) for 1..N workers, per scene, structure, dispatch mode and packet size. Every point is a warm-up
 // frame and the median of --repeats frames, each timed frame the second of two drawn back to back, the
-// worker counts interleaved round by round (the efficiency and the packet time ratio are medians of
+// structures and worker counts interleaved round by round (the efficiency and the packet time ratio are medians of
 // each round's own ratios); every table shows cellrt's time and its rays per second as a ratio to
 // Embree's with the same workers, dispatch and packet size, measured in the same run. Where the
 // efficiency goes is split: the share of the workers' time spent tracing and what the schedule took of
@@ -20,8 +20,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -53,9 +56,12 @@ struct Point {
     double efficiency;         // t(first) first / (t(N) N)
     double packet_time_ratio;  // busy(N) / busy(first): how much longer the same packets took
     std::uint64_t rays;
+    // `auto`: what its route chose over all of the structure's frames in the run, every dispatch mode
+    // and packet size (its "routed" setting); empty for other structures.
+    std::string routed;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(Point, scene, config, dispatch, packet, workers, seconds, busy_seconds,
-                                   started_seconds, waiting_seconds, efficiency, packet_time_ratio, rays)
+                                   started_seconds, waiting_seconds, efficiency, packet_time_ratio, rays, routed)
 
 // The median over rounds r of f(r).
 template <class F>
@@ -167,44 +173,51 @@ struct Timings {
     std::uint64_t rays = 0;  // a frame's, the same for every worker count
 };
 
-// A warm-up frame per worker count, then --repeats rounds over the worker counts: interleaved, so that
-// a machine whose speed drifts (shared hosts do) shifts every count alike and efficiencies hold.
-Timings timed_frames(const Scene& scene, const Accelerator& accel, RenderOptions ro, const Options& o) {
+// A warm-up frame per structure and worker count, then --repeats rounds, each over the structures and,
+// within each, over the worker counts: interleaved, so that a machine whose speed drifts (shared hosts
+// do) shifts every structure and count alike, and ratios to the yardstick and efficiencies hold. (Run
+// one structure after another, the same frames of `bvh:packet` took 0.0093 s in one run and 0.0112 s
+// in the next on the bunny, 384 x 384, beside `auto` that moved the other way.)
+std::vector<Timings> timed_frames(const Scene& scene, std::span<const Accelerator* const> accels, RenderOptions ro,
+                                  const Options& o) {
     Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
-    for (unsigned w : o.workers) {
-        ro.threads = w;
-        render(scene, accel, ro, frame);
-    }
-    Timings t;
-    RenderStats st;
-    for (int r = 0; r < o.repeats; ++r)
+    for (const Accelerator* accel : accels)
         for (unsigned w : o.workers) {
             ro.threads = w;
-            // Frames drawn back to back, as a renderer draws them: the timed frame follows one with the
-            // same workers, so it finds them still polling (RenderOptions::idle_spin), not asleep after
-            // other worker counts.
-            render(scene, accel, ro, frame);
-            render(scene, accel, ro, frame, &st);
-            Rounds& rounds = t.by_workers[w];
-            rounds.seconds.push_back(st.seconds);
-            double b = 0.0, s = 0.0, e = 0.0;
-            for (const WorkerLoad& l : st.workers) {
-                b += l.busy_seconds;
-                s += l.started_seconds;
-                e += std::max(0.0, st.seconds - l.finished_seconds);
-            }
-            rounds.busy.push_back(b);
-            rounds.started.push_back(s);
-            rounds.waiting.push_back(e);
-            t.rays = st.primary_rays + st.secondary_rays;
+            render(scene, *accel, ro, frame);
         }
-    return t;
+    std::vector<Timings> timings(accels.size());
+    RenderStats st;
+    for (int r = 0; r < o.repeats; ++r)
+        for (std::size_t a = 0; a < accels.size(); ++a)
+            for (unsigned w : o.workers) {
+                ro.threads = w;
+                // Frames drawn back to back, as a renderer draws them: the timed frame follows one with
+                // the same structure and workers, so it finds the structure in the caches and the workers
+                // still polling (RenderOptions::idle_spin), not asleep after other worker counts.
+                render(scene, *accels[a], ro, frame);
+                render(scene, *accels[a], ro, frame, &st);
+                Timings& t = timings[a];
+                Rounds& rounds = t.by_workers[w];
+                rounds.seconds.push_back(st.seconds);
+                double b = 0.0, s = 0.0, e = 0.0;
+                for (const WorkerLoad& l : st.workers) {
+                    b += l.busy_seconds;
+                    s += l.started_seconds;
+                    e += std::max(0.0, st.seconds - l.finished_seconds);
+                }
+                rounds.busy.push_back(b);
+                rounds.started.push_back(s);
+                rounds.waiting.push_back(e);
+                t.rays = st.primary_rays + st.secondary_rays;
+            }
+    return timings;
 }
 
 // The points of one scene, structure, dispatch and packet size, a worker count each, appended to
 // `points` with a progress line each on stderr.
 void add_points(const Timings& t, const std::string& scene, const std::string& config, const std::string& dispatch,
-                int packet, const Options& o, std::vector<Point>& points) {
+                int packet, const std::string& routed, const Options& o, std::vector<Point>& points) {
     const unsigned first = o.workers.front();
     const Rounds& base = t.by_workers.at(first);
     for (unsigned w : o.workers) {
@@ -215,7 +228,7 @@ void add_points(const Timings& t, const std::string& scene, const std::string& c
         const double packet_time_ratio =
             median_of_rounds(o.repeats, [&](std::size_t r) { return rounds.busy[r] / base.busy[r]; });
         points.push_back({scene, config, dispatch, packet, w, median(rounds.seconds), median(rounds.busy),
-                          median(rounds.started), median(rounds.waiting), efficiency, packet_time_ratio, t.rays});
+                          median(rounds.started), median(rounds.waiting), efficiency, packet_time_ratio, t.rays, routed});
         std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.c_str(), config.c_str(), dispatch.c_str(),
                      packet, packet, w, points.back().seconds);
     }
@@ -228,27 +241,40 @@ struct Study {
 };
 
 // One scene's points: every structure this binary has, dispatch mode and packet size, in that nesting
-// (each structure is built once and measured for all the dispatch modes and packet sizes), as
-// {"scene": its name, "points": [...]}.
+// (each structure is built once, all of them before the frames, which interleave them for every
+// dispatch mode and packet size), as {"scene": its name, "points": [...]}.
 nlohmann::json measure_scene(const Scene& scene, const Options& o) {
     const auto [width, height] = parse_image_size("--size", o.size);
-    std::vector<Point> points;
+    std::vector<std::string> names;
+    std::vector<std::unique_ptr<Accelerator>> built;
     for (const std::string& cfg_text : o.configs) {
         const AccelConfig cfg = parse_accel_config(cfg_text);
         if (!bench::built_in(cfg.kind)) continue;
-        const auto accel = make_accelerator(scene.triangles, cfg);
+        names.push_back(cfg_text);
+        built.push_back(make_accelerator(scene.triangles, cfg));
+    }
+    std::vector<const Accelerator*> accels;
+    for (const auto& a : built) accels.push_back(a.get());
+    std::vector<std::vector<Timings>> timings;  // per dispatch and packet size, per structure
+    for (const std::string& d : o.dispatches)
+        for (int p : o.packets) {
+            RenderOptions ro;
+            ro.width = width;
+            ro.height = height;
+            ro.packet = p;
+            ro.dispatch = parse_dispatch(d);
+            ro.idle_spin = std::chrono::microseconds(o.idle_spin);
+            ro.pin = o.pin;
+            ro.shading = o.shading;
+            timings.push_back(timed_frames(scene, accels, ro, o));
+        }
+    // The points in the order of one structure at a time, as the tables and files list them.
+    std::vector<Point> points;
+    for (std::size_t a = 0; a < accels.size(); ++a) {
+        const std::string routed = accels[a]->stats().setting("routed").value_or("");
+        std::size_t i = 0;
         for (const std::string& d : o.dispatches)
-            for (int p : o.packets) {
-                RenderOptions ro;
-                ro.width = width;
-                ro.height = height;
-                ro.packet = p;
-                ro.dispatch = parse_dispatch(d);
-                ro.idle_spin = std::chrono::microseconds(o.idle_spin);
-                ro.pin = o.pin;
-                ro.shading = o.shading;
-                add_points(timed_frames(scene, *accel, ro, o), scene.name, cfg_text, d, p, o, points);
-            }
+            for (int p : o.packets) add_points(timings[i++][a], scene.name, names[a], d, p, routed, o, points);
     }
     return {{"scene", scene.name}, {"points", points}};
 }
@@ -328,7 +354,7 @@ void print_time_shares(const Study& study, const Options& o, const std::string& 
     }
 }
 
-// Every point, with the run's shading (ao_samples only for ao) and the yardstick's seconds for the same
+// Every point, with the run's shading (ao_samples only for ao), `auto`'s route (routed) and the yardstick's seconds for the same
 // scene, dispatch, packet size and workers where it was measured.
 nlohmann::json points_json(const std::vector<Point>& points, const std::string& yardstick,
                            const ShadingOptions& shading) {
@@ -341,6 +367,7 @@ nlohmann::json points_json(const std::vector<Point>& points, const std::string& 
                          {"waiting_seconds", pt.waiting_seconds}, {"efficiency", pt.efficiency},
                          {"packet_time_ratio", pt.packet_time_ratio}, {"rays", pt.rays}};
         if (shading.shading == Shading::ao) j["ao_samples"] = shading.ao_samples;
+        if (!pt.routed.empty()) j["routed"] = pt.routed;
         if (const Point* y =
                 yardstick.empty() ? nullptr : find(points, pt.scene, yardstick, pt.dispatch, pt.packet, pt.workers))
             j["embree_seconds"] = y->seconds;

@@ -4,7 +4,7 @@
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(
-  COMMAND ${SCALING} --scenes builtin:city?tris=3000 --configs kd+auto bih:branched --dispatch pull mailbox
+  COMMAND ${SCALING} --scenes builtin:city?tris=3000 --configs kd+auto bih:branched auto --dispatch pull mailbox
           --packets 8 --workers 1 2 --repeats 1 --size 40x24 --shading ao --ao-samples 2
           --json ${WORK}/scaling.json --csv ${WORK}/scaling.csv
   OUTPUT_VARIABLE tables ERROR_VARIABLE log RESULT_VARIABLE rc)
@@ -18,12 +18,34 @@ foreach(expected "### kd+auto, mailbox dispatch, 8x8 packets, ao shading, 2 AO r
   endif()
 endforeach()
 
-# Every point: 2 configurations x 2 dispatch modes x 2 worker counts, each with its schedule's account.
+# Every point: 3 configurations x 2 dispatch modes x 2 worker counts, each with its schedule's account,
+# listed a configuration at a time (their frames were interleaved); `auto`'s with its route.
 file(READ ${WORK}/scaling.json json)
 string(JSON points LENGTH "${json}")
-if(NOT points EQUAL 8)
-  message(FATAL_ERROR "expected 8 points, found ${points}")
+if(NOT points EQUAL 12)
+  message(FATAL_ERROR "expected 12 points, found ${points}")
 endif()
+set(configs kd+auto bih:branched auto)
+foreach(i 0 3 4 7 8 11)
+  string(JSON config GET "${json}" ${i} config)
+  math(EXPR expected "${i} / 4")
+  list(GET configs ${expected} want)
+  string(JSON routed ERROR_VARIABLE no_route GET "${json}" ${i} routed)
+  set(has_route 0)
+  if(no_route STREQUAL "NOTFOUND")
+    set(has_route 1)
+  endif()
+  set(wants_route 0)
+  if(want STREQUAL "auto")
+    set(wants_route 1)
+  endif()
+  if(NOT config STREQUAL want OR NOT has_route EQUAL wants_route)
+    message(FATAL_ERROR "point ${i} is ${config} (routed: ${routed}), expected ${want}")
+  endif()
+  if(want STREQUAL "auto" AND NOT routed MATCHES "^closest packets ")
+    message(FATAL_ERROR "point ${i}'s route: ${routed}")
+  endif()
+endforeach()
 math(EXPR last "${points} - 1")
 foreach(i RANGE ${last})
   string(JSON seconds GET "${json}" ${i} seconds)
