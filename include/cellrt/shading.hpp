@@ -170,7 +170,7 @@ struct FrameShading {
     PinholeProjection camera;
     Vec3 light_position, light_color;
     ShadingOptions shading;
-    float ao_reach = 0.f;  // kAoReachFraction of the scene box's diagonal
+    float ao_reach = 0.f;  // AO shading: kAoReachFraction of the scene box's diagonal (else 0)
     int frame_width = 0;   // pixel (x, y) seeds its random numbers with y * frame_width + x
 };
 
