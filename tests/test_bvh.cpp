@@ -616,7 +616,7 @@ TEST(Routed, CoherenceTellsFrameRaysFromBounces) {
 // interleaved runs: kRounds rounds, each kPerPath batches per path, path after path, all but the
 // first of a path's batches timed; then the path of least time per ray takes the runs that are not
 // timed, and a timed run interleaves it with the paths near it, and with the far ones less often.
-// `take(n, prior)` picks n batches and returns how many were timed, recording for each timed one
+// `take(n, prior)` picks n batches, observing each, and returns how many were timed, recording for each timed one
 // `per_ray[path]` seconds per ray (times `tile_cost(batch)`, the batch's own cost, when given) on a
 // batch of `rays` rays, of which none hit (or `tile_hits(batch)` of them, when given).
 struct PickerRun {
@@ -631,10 +631,12 @@ struct PickerRun {
         for (int i = 0; i < n; ++i, ++batch) {
             const detail::RoutePicker::Choice c = picker.pick(prior);
             ++paths_seen[c.path];
+            const auto hits = static_cast<std::size_t>(tile_hits(batch) * static_cast<double>(rays));
+            picker.observe(rays, hits);
             if (!c.timed) continue;
             ++timed;
             picker.record(c.path, per_ray[static_cast<std::size_t>(c.path)] * tile_cost(batch) * static_cast<double>(rays),
-                          rays, static_cast<std::size_t>(tile_hits(batch) * static_cast<double>(rays)));
+                          rays, hits);
         }
         return timed;
     }
@@ -818,6 +820,87 @@ TEST(Routed, PickerComparesPathsOnTheSameMixOfHitFractions) {
     EXPECT_DOUBLE_EQ(alike.cost(1), alike.seconds(1) / alike.rays(1));
 }
 
+// The bunny's camera tiles in order (24 x 24 tiles; the object in rows 12 to 19, columns 6 to 17):
+// the learning runs see only background, where the kd-tree's packets (path 0, 1.0 per ray) beat the
+// BVH's (path 1, 1.1); on the object they take 15 per ray, the BVH's packets 8. Once tiles of all
+// hits hold kCover of the rays and neither path was timed on one, the next run is timed: the BVH's
+// packets are chosen within the first frame, and take the object's tiles from then on.
+TEST(Routed, PickerLearnsAgainOnAClassItWasNotTimedOn) {
+    using detail::RoutePicker;
+    const auto on_object = [](std::uint64_t batch) {
+        const std::uint64_t tile = batch % 576, row = tile / 24, column = tile % 24;
+        return row >= 12 && row < 20 && column >= 6 && column < 18;
+    };
+    RoutePicker picker(2);
+    const std::size_t rays = 256;
+    int object_tiles = 0, object_on_bvh = 0;
+    const auto frame = [&](std::uint64_t first) {
+        for (std::uint64_t batch = first; batch < first + 576; ++batch) {
+            const RoutePicker::Choice c = picker.pick(0);
+            const bool object = on_object(batch);
+            if (first > 0 && object) ++object_tiles, object_on_bvh += c.path == 1;
+            const std::size_t hits = object ? rays : 0;
+            picker.observe(rays, hits);
+            if (!c.timed) continue;
+            const double per_ray = object ? (c.path == 0 ? 15.0 : 8.0) : (c.path == 0 ? 1.0 : 1.1);
+            picker.record(c.path, per_ray * static_cast<double>(rays), rays, hits);
+        }
+    };
+    frame(0);
+    EXPECT_FALSE(picker.uncovered());
+    EXPECT_EQ(picker.fastest(0), 1) << "per ray: kd packets " << picker.cost(0) << ", BVH packets " << picker.cost(1);
+    frame(576);
+    frame(2 * 576);
+    EXPECT_GT(object_on_bvh, object_tiles * 9 / 10) << object_on_bvh << " of " << object_tiles;
+
+    // A class the runs never cover (here every batch is seen with all rays hitting and timed as if
+    // none did) makes runs timed again ever more seldom: after 4, 8, 16 ... 256 runs, not one run in
+    // four for good, whose runs would give the far path (ten times the cost) its share of those in
+    // which far paths join.
+    RoutePicker never(2);
+    const std::uint64_t runs = 1000, batches = RoutePicker::kPrior + runs * never.run_length();
+    int far_batches = 0;
+    for (std::uint64_t i = 0; i < batches; ++i) {
+        const RoutePicker::Choice c = never.pick(0);
+        never.observe(rays, rays);
+        far_batches += c.path == 1;
+        if (c.timed) never.record(c.path, (c.path == 0 ? 1.0 : 10.0) * static_cast<double>(rays), rays, 0);
+    }
+    EXPECT_TRUE(never.uncovered());
+    EXPECT_LT(far_batches, 400);
+
+    // Two paths are compared on the classes both were timed in: a slow path timed on background
+    // only (path 2) does not leave the object's tiles out of the others' comparison, where one mix
+    // for all would (cost() and mix(), the report's figures).
+    RoutePicker pairs(3);
+    pairs.observe(1000, 0), pairs.observe(3000, 3000);
+    pairs.record(0, 100.0, 100, 0), pairs.record(0, 1500.0, 100, 100);
+    pairs.record(1, 110.0, 100, 0), pairs.record(1, 800.0, 100, 100);
+    pairs.record(2, 300.0, 100, 0);
+    EXPECT_EQ(pairs.fastest(0), 1);
+    EXPECT_LT(pairs.cost(0), pairs.cost(1));  // on background alone, the common mix
+    const auto c = pairs.compared(0, 1);
+    EXPECT_DOUBLE_EQ(c[0], 0.25 * 1.0 + 0.75 * 15.0);
+    EXPECT_DOUBLE_EQ(c[1], 0.25 * 1.1 + 0.75 * 8.0);
+    EXPECT_TRUE(pairs.far(2, 1));  // on background, the class they share: 3.0 against 1.1
+    EXPECT_TRUE(pairs.far(0, 1));  // 11.5 against 6.3
+    EXPECT_FALSE(pairs.uncovered());  // the one path in contention was timed in both classes
+
+    // A class below kCover of the rays, or one that a path left out lacks, does not make a run learn.
+    RoutePicker few(2), left(3, 1u);
+    few.observe(1000, 0), few.observe(10, 10), few.record(0, 1.0, 100, 0), few.record(1, 1.0, 100, 0);
+    EXPECT_FALSE(few.uncovered());
+    few.observe(100, 100);
+    EXPECT_TRUE(few.uncovered());
+    left.observe(100, 100), left.record(1, 1.0, 100, 100), left.record(2, 1.0, 100, 100);
+    EXPECT_FALSE(left.uncovered());
+    // The classes are weighted by every batch observed, not only the timed ones.
+    EXPECT_DOUBLE_EQ(few.mix()[0], 1.0);  // all hits left out: neither path was timed on such a batch
+    few.record(0, 1.0, 100, 100), few.record(1, 2.0, 100, 100);
+    EXPECT_NEAR(few.mix()[0], 1000.0 / 1110, 1e-12);
+    EXPECT_NEAR(few.mix()[2], 110.0 / 1110, 1e-12);
+}
+
 // Once the picker knows: one run in kSample is timed; it interleaves the fastest with every path
 // within kFar of it, and with one that costs more than kFar times the fastest in kSampleFar /
 // kSample of them (in the others the fastest runs alone, timed, then takes the run's rest).
@@ -952,7 +1035,7 @@ TEST_P(RoutedPaths, StreamedBatchesAnswerAsBruteForce) {
     const std::string routes = routed->stats().setting("routed").value_or("");
     const bool study_packets = spec == "auto";
     EXPECT_EQ(routes.find(" bvh-packets ") != std::string::npos, study_packets) << routes;
-    for (const std::string& name : {"packets", "paired", "stream", "bvh-packets"}) {
+    for (const std::string name : {"packets", "paired", "stream", "bvh-packets"}) {
         if (name == "bvh-packets" && !study_packets) continue;
         const std::string path = " " + name + " ";
         for (std::size_t at = routes.find(path), seen = 0; seen < 2; at = routes.find(path, at + 1), ++seen) {

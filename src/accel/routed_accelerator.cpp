@@ -48,8 +48,8 @@ public:
     // otherwise (bvh_with_traversal) after them.
     RoutedAccelerator(std::vector<RoutePath> paths, float threshold, std::string packets, bool measured)
         : paths_(std::move(paths)), threshold_(threshold), packets_(std::move(packets)), measured_(measured),
-          pickers_{RoutePicker(count()), RoutePicker(count(), incoherent_left_out()), RoutePicker(count()),
-                   RoutePicker(count(), incoherent_left_out())} {}
+          pickers_{RoutePicker(count(), coherent_left_out()), RoutePicker(count(), incoherent_left_out()),
+                   RoutePicker(count(), coherent_left_out()), RoutePicker(count(), incoherent_left_out())} {}
 
     AccelStats stats() const override {
         const AccelStats c = paths_[0].accel->stats();
@@ -113,11 +113,17 @@ private:
         LastPath& last = last_path_[kind];
         const bool warm = last.owner == this && last.path == choice.path;
         last = {this, choice.path};
-        if (!choice.timed) return trace(*paths_[choice.path].accel, counters);
+        if (!choice.timed) {
+            trace(*paths_[choice.path].accel, counters);
+            picker.observe(rays.size(), hits());
+            return;
+        }
         const double start = thread_seconds();
         trace(*paths_[choice.path].accel, counters);
         const double seconds = thread_seconds() - start;
-        if (warm) picker.record(choice.path, seconds, rays.size(), hits());
+        const std::size_t hit = hits();
+        picker.observe(rays.size(), hit);
+        if (warm) picker.record(choice.path, seconds, rays.size(), hit);
     }
 
     void count_rays(int query, int path, std::size_t n) const {
@@ -165,6 +171,12 @@ private:
     // The paths the incoherent batches' pickers leave out: a study tree's packets (RoutePicker),
     // where at least two of the BVH's paths are left to choose between.
     unsigned incoherent_left_out() const { return !paths_[0].view && count() >= 3 ? 1u : 0u; }
+    // The paths the coherent batches' pickers leave out: the BVH's single rays (path 1), where at
+    // least two other paths are held. Timed on coherent batches in whole frames (direct, AO and
+    // diffuse shading, the four shared scenes) they took 1.5 to 5.1 times the fastest path's time
+    // per ray and were never the fastest, and every learning run gave them a share of the camera
+    // tiles (docs/INCOHERENT.md, "Twentieth round").
+    unsigned coherent_left_out() const { return count() >= 3 ? 2u : 0u; }
 
     std::vector<RoutePath> paths_;
     float threshold_;
