@@ -1,0 +1,36 @@
+#!/bin/sh
+# docs/INCOHERENT.md, "Twentieth round": the route's runs and classes. From the repository root, with
+# OLD the build directory of the commit before the round (d2541d2; its bench/scaling_bench.cpp
+# replaced by this round's, so that both interleave their structures) and build/ the route measured.
+# Each folder below held one route as b (or c); a is the old one in the same turns.
+OLD=${OLD:?the old build directory}
+D=docs/figures/route_cover
+# sequential/: before cellrt_scaling interleaved its structures, direct frames, a b b a a b
+# (the old bench/scaling_bench.cpp in both builds).
+# interleaved_02/ (classes covered at 2 %, every fourth run), cover_mix/ (5 %, backing off),
+# pairs/ (paths compared two at a time), kept/ (the BVH's single rays left out of coherent batches):
+n=0
+for who in a b b a; do
+  n=$((n + 1))
+  [ $who = a ] && B=$OLD/bench/cellrt_scaling || B=build/bench/cellrt_scaling
+  for s in direct ao diffuse; do
+    $B --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+      --configs embree:packet16 auto kd+auto bvh:packet --dispatch pull --packets 16 --workers 1 \
+      --repeats 7 --size 384x384 --shading $s --json $D/kept/f_${who}_${s}_$n.json > /dev/null 2>&1
+  done
+done
+# affinity/ (not kept): the new binary alone, three runs, as f_c_*.
+# first_frame/: one frame per process, the route learning within it, in turns a b b a, six times:
+for i in 1 2 3 4 5 6; do
+  for who in a b b a; do
+    [ $who = a ] && B=$OLD/cellrt || B=build/cellrt
+    for s in sponza sibenik bunny teapot; do
+      for acc in auto bvh:packet kd; do
+        line=$($B render ../shared/scenes/$s/$s.json --accel $acc --threads 1 --size 384x384 \
+          -o /tmp/route_cover.png --overwrite 2>&1 | grep -o "render [0-9.]* s")
+        echo "$who $s $acc $line" >> $D/first_frame/kept.txt
+      done
+    done
+  done
+done
+python3 $D/tables.py > $D/tables.md
