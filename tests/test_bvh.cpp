@@ -801,8 +801,9 @@ TEST(Routed, PickerComparesPathsOnTheSameMixOfHitFractions) {
     EXPECT_NEAR(picker.cost(1), m[0] * 0.1 + m[1] * (0.1 + 0.9 / 4) + m[2] * 1.0, 1e-12);
     EXPECT_EQ(picker.fastest(0), 1);
 
-    // A class that some path was not timed in (here the kd packets' tiles of all hits, the BVH
-    // packets' of some) is left out for every path.
+    // For the report's figures (cost(), mix()), a class that some path was not timed in (here the kd
+    // packets' tiles of all hits, the BVH packets' of some) is left out for every path; the choice
+    // compares paths two at a time (PickerLearnsAgainOnAClassItWasNotTimedOn).
     detail::RoutePicker gap(2);
     gap.record(0, 10.0, 100, 0), gap.record(0, 50.0, 100, 30), gap.record(1, 5.0, 100, 0), gap.record(1, 7.0, 100, 100);
     EXPECT_DOUBLE_EQ(gap.mix()[0], 1.0);
@@ -820,16 +821,17 @@ TEST(Routed, PickerComparesPathsOnTheSameMixOfHitFractions) {
     EXPECT_DOUBLE_EQ(alike.cost(1), alike.seconds(1) / alike.rays(1));
 }
 
-// The bunny's camera tiles in order (24 x 24 tiles; the object in rows 12 to 19, columns 6 to 17):
+// The bunny's camera tiles in order (24 x 24 tiles; the object in rows 17 to 22, columns 6 to 17):
 // the learning runs see only background, where the kd-tree's packets (path 0, 1.0 per ray) beat the
-// BVH's (path 1, 1.1); on the object they take 15 per ray, the BVH's packets 8. Once tiles of all
-// hits hold kCover of the rays and neither path was timed on one, the next run is timed: the BVH's
-// packets are chosen within the first frame, and take the object's tiles from then on.
+// BVH's (path 1, 1.1); on the object they take 15 per ray, the BVH's packets 8. The first frame's
+// one timed run of the usual kind (run 21, batches 386 to 403) ends before the object: only the run
+// timed because tiles of all hits hold kCover of the rays and neither path was timed on one lets
+// the BVH's packets be chosen within the first frame; they take the object's tiles from then on.
 TEST(Routed, PickerLearnsAgainOnAClassItWasNotTimedOn) {
     using detail::RoutePicker;
     const auto on_object = [](std::uint64_t batch) {
         const std::uint64_t tile = batch % 576, row = tile / 24, column = tile % 24;
-        return row >= 12 && row < 20 && column >= 6 && column < 18;
+        return row >= 17 && row < 23 && column >= 6 && column < 18;
     };
     RoutePicker picker(2);
     const std::size_t rays = 256;
@@ -856,7 +858,7 @@ TEST(Routed, PickerLearnsAgainOnAClassItWasNotTimedOn) {
     // A class the runs never cover (here every batch is seen with all rays hitting and timed as if
     // none did) makes runs timed again ever more seldom: after 4, 8, 16 ... 256 runs, not one run in
     // four for good, whose runs would give the far path (ten times the cost) its share of those in
-    // which far paths join.
+    // which far paths join (702 batches of it, measured so).
     RoutePicker never(2);
     const std::uint64_t runs = 1000, batches = RoutePicker::kPrior + runs * never.run_length();
     int far_batches = 0;

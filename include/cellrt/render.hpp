@@ -67,7 +67,7 @@ void render_window(const Scene& scene, const Accelerator& accel, const RenderOpt
 
 // One frame traced window by window (a distributed frame, tile by tile): the camera and every
 // worker's packet buffers are made once, so a frame cut into many windows costs no more set-up than
-// one (a workload's set-up reads every triangle for the AO rays' reach). Throws as render() does.
+// one (with AO shading a workload's set-up reads every triangle for the rays' reach). Throws as render() does.
 // One thread at a time may call render_window; scene, accel and options must outlive the renderer.
 class FrameRenderer {
 public:

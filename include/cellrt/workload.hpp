@@ -67,8 +67,8 @@ class PacketWorkload {
 public:
     PacketWorkload(const Scene& scene, const PinholeCamera& camera, std::size_t max_pixels,
                    const ShadingOptions& shading = {});
-    // The same, for a frame already made by frame_shading(scene, camera, shading), which reads every
-    // triangle (the AO rays' reach): the workers of one frame share one. Throws cellrt::Error for AO
+    // The same, for a frame already made by frame_shading(scene, camera, shading), which for AO reads
+    // every triangle (the rays' reach): the workers of one frame share one. Throws cellrt::Error for AO
     // samples out of range, as frame_shading does.
     PacketWorkload(const Scene& scene, const FrameShading& frame, std::size_t max_pixels);
     PacketWorkload(PacketWorkload&&) noexcept;

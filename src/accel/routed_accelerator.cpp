@@ -157,7 +157,7 @@ private:
             for (int p = 0; p < count(); ++p) {
                 if (!picker.takes_part(p)) continue;
                 char buf[48];
-                std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p));
+                std::snprintf(buf, sizeof buf, " %s %.1f", paths_[p].name, 1e9 * picker.cost(p, m));
                 out += buf;
             }
         }
@@ -173,9 +173,9 @@ private:
     unsigned incoherent_left_out() const { return !paths_[0].view && count() >= 3 ? 1u : 0u; }
     // The paths the coherent batches' pickers leave out: the BVH's single rays (path 1), where at
     // least two other paths are held. Timed on coherent batches in whole frames (direct, AO and
-    // diffuse shading, the four shared scenes) they took 1.5 to 5.1 times the fastest path's time
-    // per ray and were never the fastest, and every learning run gave them a share of the camera
-    // tiles (docs/INCOHERENT.md, "Twentieth round").
+    // diffuse shading, the four shared scenes) they took 1.4 to 5.1 times the fastest path's time
+    // per ray (1.4 to 3.7 with packets=bvh) and were never the fastest, and every learning run gave
+    // them a share of the camera tiles (docs/INCOHERENT.md, "Twentieth round").
     unsigned coherent_left_out() const { return count() >= 3 ? 2u : 0u; }
 
     std::vector<RoutePath> paths_;

@@ -80,8 +80,8 @@ const std::vector<std::string>& routed_traversals();
 // 152 camera tiles are all background, where the kd-tree's packets, cheapest on misses, kept its
 // camera rays for three frames although the BVH's packets take half their time on the object), the
 // next run is timed too, and then one after kRelearn runs, twice as many after each further one (up
-// to kRelearnDoublings times), so that a class the runs seldom meet costs a few runs, not one in
-// kRelearn for good. Times are the thread's CPU time, so a batch whose thread the system preempted
+// to kRelearnDoublings times; never reset), so that a class the runs seldom meet costs a few runs,
+// not one in kRelearn for good. Times are the thread's CPU time, so a batch whose thread the system preempted
 // does not count the other threads' time. Sums are atomics: any number of threads route and record
 // at once, and a race only blurs a figure.
 //
@@ -92,7 +92,7 @@ const std::vector<std::string>& routed_traversals();
 // timed at 121 ns a ray on Sibenik's AO rays where they take 104 alone, behind the streams (118),
 // which read each node once per batch; without the kd-tree's runs they were timed at 89 to 95
 // (docs/INCOHERENT.md, "Nineteenth round"). Likewise the BVH's single rays take no part in the
-// coherent batches' runs where two other paths are held: timed there in whole frames they took 1.5
+// coherent batches' runs where two other paths are held: timed there in whole frames they took 1.4
 // to 5.1 times the fastest path's time and never led, and each learning run gave them camera tiles
 // (docs/INCOHERENT.md, "Twentieth round").
 class RoutePicker {
@@ -216,18 +216,16 @@ public:
         if (n < kPrior) return {prior, false};
         const std::uint64_t length = run_length(), run = (n - kPrior) / length, at = (n - kPrior) % length;
         const std::uint64_t h = mix(run);
-        // A run that learns again is decided at its first batch (a later one of the run may see the
-        // class covered by then); with several threads a batch of the run picked before that is
-        // decided goes as in a timed run, which only blurs a figure.
-        if (at == 0 && run >= kLearnRuns) {
-            if (!uncovered()) {
-                relearned_.store(0, std::memory_order_relaxed);
-            } else if (run >= next_relearn_.load(std::memory_order_relaxed)) {
-                const std::uint64_t times = relearned_.fetch_add(1, std::memory_order_relaxed);
-                next_relearn_.store(run + (kRelearn << std::min<std::uint64_t>(times, kRelearnDoublings)),
-                                    std::memory_order_relaxed);
-                relearning_.store(run, std::memory_order_relaxed);
-            }
+        // A run timed for an uncovered class is decided at its first batch (a later one of the run may
+        // see the class covered by then); with several threads a batch of the run picked before that
+        // is decided goes untimed to the fastest, which only blurs a figure. The back-off is never
+        // reset: a class that comes and goes (a path moving in and out of contention) costs no more
+        // than one that stays uncovered.
+        if (at == 0 && run >= kLearnRuns && run >= next_relearn_.load(std::memory_order_relaxed) && uncovered()) {
+            const std::uint64_t times = relearned_.fetch_add(1, std::memory_order_relaxed);
+            next_relearn_.store(run + (kRelearn << std::min<std::uint64_t>(times, kRelearnDoublings)),
+                                std::memory_order_relaxed);
+            relearning_.store(run, std::memory_order_relaxed);
         }
         int in_run[kMaxPaths];
         int k = 0;
@@ -251,7 +249,9 @@ public:
         return {path, slot % kPerPath != 0};
     }
     // The path of least time per ray among those with counted batches, each compared with the fastest
-    // so far on the classes the two share (compared()); the prior while none has.
+    // so far on the classes the two share (compared()); the prior while none has. Compared so, three
+    // paths timed in different classes need not be ordered one way (a beats b, b beats c, c beats
+    // a); the scan in path order then settles it.
     int fastest(int prior) const {
         int fast = -1;
         for (int p = 0; p < paths_; ++p) {
@@ -325,8 +325,8 @@ private:
     std::atomic<double> seconds_[kMaxPaths][kStrata]{}, rays_[kMaxPaths][kStrata]{};
     // Per class of hit fraction: the rays of every batch observed.
     std::atomic<double> population_[kStrata]{};
-    // The last run that learns again (pick()), none at first; the first run that may, and how many
-    // have since every class was last covered.
+    // The last run timed for an uncovered class (pick()), none at first; the first run that may be,
+    // and how many have been.
     std::atomic<std::uint64_t> relearning_{~std::uint64_t{0}}, next_relearn_{0}, relearned_{0};
 };
 
