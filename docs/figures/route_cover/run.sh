@@ -19,8 +19,11 @@ for who in a b b a; do
       --repeats 7 --size 384x384 --shading $s --json $D/kept/f_${who}_${s}_$n.json > /dev/null 2>&1
   done
 done
-# affinity/ (not kept): the new binary alone, three runs, as f_c_*.
-# first_frame/: one frame per process, the route learning within it, in turns a b b a, six times:
+# Each of the other folders holds the same loop's output with its own build as b (interleaved_02/
+# and cover_mix/ six turns, a b b a a b); affinity/ (not kept): its build alone, three runs, as f_c_*.
+# first_frame/: one frame per process, the route learning within it, in turns a b b a, six times
+# (cover_mix.txt and pairs.txt: the same with those folders' builds):
+: > $D/first_frame/kept.txt
 for i in 1 2 3 4 5 6; do
   for who in a b b a; do
     [ $who = a ] && B=$OLD/cellrt || B=build/cellrt
@@ -32,5 +35,19 @@ for i in 1 2 3 4 5 6; do
       done
     done
   done
+done
+# first_three/: the route after three frames (the warm-up and a timed pair), old (a) and new (b):
+for i in 1 2 3; do
+  for who in a b; do
+    [ $who = a ] && B=$OLD/bench/cellrt_scaling || B=build/bench/cellrt_scaling
+    $B --scenes-dir ../shared/scenes --scenes bunny teapot sponza sibenik --configs auto --dispatch pull \
+      --packets 16 --workers 1 --repeats 1 --size 384x384 --shading direct --json $D/first_three/${who}_$i.json
+  done
+done
+# packets_bvh/: the old route with packets=bvh, the single rays' time on coherent batches:
+for s in direct ao diffuse; do
+  $OLD/bench/cellrt_scaling --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs auto@packets=bvh --dispatch pull --packets 16 --workers 1 --repeats 3 --size 384x384 \
+    --shading $s --json $D/packets_bvh/old_$s.json
 done
 python3 $D/tables.py > $D/tables.md

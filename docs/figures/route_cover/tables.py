@@ -64,7 +64,7 @@ for sh in SHADINGS:
         print(f'| {sh} | {sc} | ' + ' | '.join(cells) + ' |')
 
 print('\n## One frame per process (`cellrt render`, 384 x 384, one thread, the route learning within it): '
-      'render time in ms, old (a) → new (b), mean of 24 renders each\n')
+      'render time in ms, old (a) → new (b), mean of 12 renders each (printed to the millisecond)\n')
 files = [('cover 5 %, backing off', 'cover_mix.txt'), ('pairs', 'pairs.txt'), ('kept', 'kept.txt')]
 print('| scene | accel | ' + ' | '.join(n for n, _ in files) + ' |\n|---|---|' + '--:|' * len(files))
 times = []
