@@ -50,4 +50,10 @@ for s in direct ao diffuse; do
     --configs auto@packets=bvh --dispatch pull --packets 16 --workers 1 --repeats 3 --size 384x384 \
     --shading $s --json $D/packets_bvh/old_$s.json
 done
+# two_workers/: whole frames with one and two workers against Embree's fastest, the kept route:
+for s in ao diffuse; do
+  build/bench/cellrt_scaling --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:single embree:packet8 embree:packet16 auto --dispatch pull --packets 16 \
+    --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/two_workers/scaling_$s.json
+done
 python3 $D/tables.py > $D/tables.md

@@ -79,3 +79,16 @@ for sc in SCENES:
     for acc in ['auto', 'kd', 'bvh:packet']:
         cells = [f"{statistics.mean(t[(sc, acc, 'a')]):.2f} → {statistics.mean(t[(sc, acc, 'b')]):.2f}" for t in times]
         print(f'| {sc} | {acc} | ' + ' | '.join(cells) + ' |')
+
+print("\n## Whole frames with one and two workers (two_workers/): Embree's fastest of its single rays and "
+      "packets of eight and sixteen over auto's frame time\n")
+print('| shading | workers | ' + ' | '.join(SCENES) + ' |\n|---|--:|' + '--:|' * len(SCENES))
+for sh in ['ao', 'diffuse']:
+    pts = json.load(open(os.path.join(HERE, 'two_workers', f'scaling_{sh}.json')))
+    for w in (1, 2):
+        cells = []
+        for sc in SCENES:
+            t = {p['config']: p['seconds'] for p in pts if p['scene'] == sc and p['workers'] == w}
+            embree = min(v for k, v in t.items() if k.startswith('embree'))
+            cells.append(f"{embree / t['auto']:.2f}")
+        print(f'| {sh} | {w} | ' + ' | '.join(cells) + ' |')
