@@ -179,10 +179,10 @@ struct Timings {
 // one structure after another, `bvh:packet`'s speed over Embree's on the bunny's 384 x 384 direct
 // frames spread from 1.25 to 1.69 over six runs; interleaved, from 1.24 to 1.32 over four:
 // docs/figures/route_cover.)
-std::vector<Timings> timed_frames(const Scene& scene, std::span<const Accelerator* const> accels, RenderOptions ro,
-                                  const Options& o) {
+std::vector<Timings> timed_frames(const Scene& scene, std::span<const std::unique_ptr<Accelerator>> accels,
+                                  RenderOptions ro, const Options& o) {
     Image frame;  // kept from frame to frame, as a renderer keeps its frame buffer
-    for (const Accelerator* accel : accels)
+    for (const auto& accel : accels)
         for (unsigned w : o.workers) {
             ro.threads = w;
             render(scene, *accel, ro, frame);
@@ -247,15 +247,13 @@ struct Study {
 nlohmann::json measure_scene(const Scene& scene, const Options& o) {
     const auto [width, height] = parse_image_size("--size", o.size);
     std::vector<std::string> names;
-    std::vector<std::unique_ptr<Accelerator>> built;
+    std::vector<std::unique_ptr<Accelerator>> accels;
     for (const std::string& cfg_text : o.configs) {
         const AccelConfig cfg = parse_accel_config(cfg_text);
         if (!bench::built_in(cfg.kind)) continue;
         names.push_back(cfg_text);
-        built.push_back(make_accelerator(scene.triangles, cfg));
+        accels.push_back(make_accelerator(scene.triangles, cfg));
     }
-    std::vector<const Accelerator*> accels;
-    for (const auto& a : built) accels.push_back(a.get());
     std::vector<std::vector<Timings>> timings;  // per dispatch and packet size, per structure
     for (const std::string& d : o.dispatches)
         for (int p : o.packets) {

@@ -113,17 +113,12 @@ private:
         LastPath& last = last_path_[kind];
         const bool warm = last.owner == this && last.path == choice.path;
         last = {this, choice.path};
-        if (!choice.timed) {
-            trace(*paths_[choice.path].accel, counters);
-            picker.observe(rays.size(), hits());
-            return;
-        }
-        const double start = thread_seconds();
+        const double start = choice.timed ? thread_seconds() : 0.0;
         trace(*paths_[choice.path].accel, counters);
-        const double seconds = thread_seconds() - start;
+        const double seconds = choice.timed ? thread_seconds() - start : 0.0;
         const std::size_t hit = hits();
         picker.observe(rays.size(), hit);
-        if (warm) picker.record(choice.path, seconds, rays.size(), hit);
+        if (choice.timed && warm) picker.record(choice.path, seconds, rays.size(), hit);
     }
 
     void count_rays(int query, int path, std::size_t n) const {
