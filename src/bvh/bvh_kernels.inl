@@ -261,9 +261,12 @@ inline void push_children(const BvhNode& node, unsigned met, F entries, std::uin
     const auto lanes = reinterpret_cast<__m256>(entries);
 #endif
 #if defined(CELLRT_SIMD_AVX512)
+    // Compressed in a register, then stored as a whole row (the stack's slack takes the lanes past
+    // the children): on Zen 4 the compress with a memory operand is microcoded, and the two of them
+    // held 31 % of the paired walks' samples on random rays (docs/INCOHERENT.md, twenty-first round).
     const auto mask = static_cast<__mmask8>(met);
-    _mm256_mask_compressstoreu_epi32(word_stack + size, mask, words);
-    if (entry_stack) _mm256_mask_compressstoreu_ps(entry_stack + size, mask, lanes);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(word_stack + size), _mm256_maskz_compress_epi32(mask, words));
+    if (entry_stack) _mm256_storeu_ps(entry_stack + size, _mm256_maskz_compress_ps(mask, lanes));
 #elif defined(CELLRT_SIMD_AVX2)
     const __m256i order = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kPackTable.order[met])));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(word_stack + size), _mm256_permutevar8x32_epi32(words, order));
