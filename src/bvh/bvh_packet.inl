@@ -61,7 +61,7 @@ inline unsigned packet_meets(const BvhNode& node, int k, const RayLanes& p, F cu
         leave = min_keep(leave, select(p.negative[a], to_lo, to_hi));
     }
     entry = enter - p.margin;
-    return bits(entry <= min_keep(cull, leave + p.margin));
+    return bits_le(entry, min_keep(cull, leave + p.margin));
 }
 
 // A branch waiting on the packet's stack: the node's word, its rays (lane bits) and their smallest entry.
@@ -168,7 +168,7 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
             if (size == 0) return active;
             const PacketFrame& f = stack[--size];
             mask = f.rays & active;
-            if constexpr (!kAny) mask &= bits(splat(f.entry) <= cull);
+            if constexpr (!kAny) mask &= bits_le(splat(f.entry), cull);
             if (mask) {
                 word = f.word;
                 break;

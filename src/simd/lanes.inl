@@ -54,6 +54,21 @@ inline unsigned lane_bits(V m) {
 inline unsigned bits(I m) { return lane_bits(m); }
 inline bool any(I m) { return bits(m) != 0; }
 
+// bits(a <= b) (false where either lane is NaN) straight from the compare where the set has mask
+// registers: GCC 12 turns an AVX-512 compare's mask into a vector of lanes and back before it reaches
+// a general register. By the vector's size, as lane_bits.
+template <class V>
+inline unsigned lane_bits_le(V a, V b) {
+#if defined(CELLRT_SIMD_AVX512)
+    if constexpr (sizeof(V) == 64)
+        return _mm512_cmp_ps_mask(reinterpret_cast<__m512>(a), reinterpret_cast<__m512>(b), _CMP_LE_OQ);
+    if constexpr (sizeof(V) == 32)
+        return _mm256_cmp_ps_mask(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b), _CMP_LE_OQ);
+#endif
+    return lane_bits(a <= b);
+}
+inline unsigned bits_le(F a, F b) { return lane_bits_le(a, b); }
+
 // IEEE square root lane by lane (correctly rounded, so equal to std::sqrt).
 template <class V>
 inline V lane_sqrt(V x) {

@@ -1,0 +1,31 @@
+#!/bin/sh
+# The twenty-first round (docs/INCOHERENT.md): the BVH's push compressed in a register, old binary
+# (365fc29) against new, every ray kind, three rounds a b b a a b; then issue 18's state table.
+# Run from the repository root: docs/figures/compress_store/run.sh OLD_BENCH
+set -e
+D=docs/figures/compress_store
+OLD=${1:?usage: run.sh OLD/cellrt_bench}
+for k in random ao diffuse frame; do
+  python3 bench/ab_compare.py "$OLD" build/bench/cellrt_bench --rounds 3 --json $D/ab_$k.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh bvh:wide bvh:packet auto \
+    --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/ab_$k.md
+done
+mkdir -p $D/state
+bench/incoherent_state.sh $D/state
+# two_workers/: whole frames, one and two workers, against Embree's fastest (as route_cover/two_workers/),
+# with bvh:packet beside auto:
+mkdir -p $D/two_workers
+for s in ao diffuse; do
+  build/bench/cellrt_scaling --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:single embree:packet8 embree:packet16 auto bvh:packet --dispatch pull --packets 16 \
+    --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/two_workers/scaling_$s.json
+done
+# mask_compare_*: the packets' box test's bits straight from the compare (bits_le), the binary before
+# it (BEFORE_MASK, the push change alone) against the new one, two rounds:
+if [ -n "$BEFORE_MASK" ]; then
+  for k in ao frame; do
+    python3 bench/ab_compare.py "$BEFORE_MASK" build/bench/cellrt_bench --rounds 2 --json $D/mask_compare_$k.json -- \
+      --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
+      --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/mask_compare_$k.md
+  done
+fi
