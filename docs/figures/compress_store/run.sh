@@ -29,3 +29,14 @@ if [ -n "$BEFORE_MASK" ]; then
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/mask_compare_$k.md
   done
 fi
+python3 docs/figures/kd_octant/state/kd_branched_ratio.py docs/figures/compress_store/state > docs/figures/compress_store/state/kd_branched_ratio.txt
+# single_below/: kPacketSingleBelow (bvh_packet.inl) re-measured with the faster walks: binaries built
+# with any hit ANY and closest hit CLOSEST in place of 3 and 1 (B_ANY_CLOSEST), against the kept one (B0):
+for v in 5_1 8_1 3_2 3_3; do
+  [ -x "$B_DIR/b_$v" ] || continue
+  for k in ao frame diffuse; do
+    python3 bench/ab_compare.py "$B_DIR/b0" "$B_DIR/b_$v" --rounds 2 --json $D/single_below/${v}_$k.json -- \
+      --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
+      --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/single_below/${v}_$k.md
+  done
+done
