@@ -40,3 +40,11 @@ for v in 5_1 8_1 3_2 3_3; do
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/single_below/${v}_$k.md
   done
 done
+# not_kept/wl_*: watertight_leaf marked [[gnu::always_inline]] (B_WL), against the kept build (B_BASE):
+if [ -n "$B_WL" ]; then
+  for k in random ao diffuse; do
+    python3 bench/ab_compare.py "$B_BASE" "$B_WL" --rounds 2 --json $D/not_kept/wl_$k.json -- \
+      --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh bvh:packet bvh:stream \
+      --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/not_kept/wl_$k.md
+  done
+fi
