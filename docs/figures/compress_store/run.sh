@@ -48,3 +48,15 @@ if [ -n "$B_WL" ]; then
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/not_kept/wl_$k.md
   done
 fi
+# in_place/: the kd-tree's (and BIH's) packets made in place in trace_batch (B_IN_PLACE) against the
+# build before it (B_BEFORE_IN_PLACE): instructions (callgrind, AVX2 under valgrind) and two timed runs.
+if [ -n "$B_IN_PLACE" ]; then
+  python3 bench/ab_callgrind.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --json $D/in_place/callgrind_frame.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza bunny --configs kd+auto --rays frame --size 128x128 --repeats 1 --builds 1
+  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --rounds 3 --json $D/in_place/time_frame_1.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto bih+auto \
+    --rays frame --repeats 5 --builds 1 --size 256x256 --clock cpu
+  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --rounds 3 --json $D/in_place/time_frame_2.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto \
+    --rays frame --repeats 7 --builds 1 --size 256x256 --clock cpu
+fi
