@@ -60,3 +60,13 @@ if [ -n "$B_IN_PLACE" ]; then
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto \
     --rays frame --repeats 7 --builds 1 --size 256x256 --clock cpu
 fi
+# coherence/: batch_coherence over 16 pairs (B_PAIRS16) against 64 (B_PAIRS64): perf of auto on the
+# teapot's random rays (perf.txt) and two A/B runs.
+if [ -n "$B_PAIRS16" ]; then
+  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --rounds 3 --json $D/coherence/ab_random.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh auto \
+    --rays random --repeats 5 --builds 1 --size 256x256 --clock cpu
+  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --rounds 3 --json $D/coherence/ab_ao.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
+    --rays ao --repeats 5 --builds 1 --size 256x256 --clock cpu
+fi
