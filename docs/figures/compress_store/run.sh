@@ -70,3 +70,4 @@ if [ -n "$B_PAIRS16" ]; then
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
     --rays ao --repeats 5 --builds 1 --size 256x256 --clock cpu
 fi
+mkdir -p $D/state_head && bench/incoherent_state.sh $D/state_head && python3 docs/figures/kd_octant/state/kd_branched_ratio.py $D/state_head > $D/state_head/kd_branched_ratio.txt   # at the round's last code commit
