@@ -473,6 +473,54 @@ TEST(Bvh, RaysSetUpInLanesKeepTiesAndSignsOfTheirDirections) {
         }
 }
 
+// A leaf that at least as many of a packet's rays reach as it holds triangles is tested one triangle
+// at a time in the rays' lanes (bvh_packet.inl, test_leaf_lanes), each lane in its own ray's axis
+// order. An octahedron of eight triangles (one or two leaves); every packet's rays come from
+// origins on all six sides and the eight diagonals (every dominant axis and sign, so mixed orders
+// in a packet) and pass through its vertices and edges (edge functions of zero: the double-precision
+// path), its faces' centres and points off it; and rays that start at the centre (t = 0 allowed) or
+// end on a face (tfar exactly the hit's t, any hit and closest hit at the bound). Brute force's
+// answers, t, u, v and triangle, on every instruction set, in packets of eight and sixteen.
+TEST(Bvh, PacketsTestALeafInTheirRaysLanes) {
+    const Vec3 v[6] = {{1.f, 0.f, 0.f}, {-1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, -1.f, 0.f}, {0.f, 0.f, 1.f}, {0.f, 0.f, -1.f}};
+    std::vector<Triangle> tris;
+    for (int x : {0, 1})
+        for (int y : {2, 3})
+            for (int z : {4, 5}) tris.push_back(Triangle{v[x], v[y], v[z]});
+    std::vector<Vec3> targets(std::begin(v), std::end(v));
+    for (int a = 0; a < 6; ++a)
+        for (int b = a + 1; b < 6; ++b)
+            if (!(v[a] + v[b] == Vec3{})) targets.push_back((v[a] + v[b]) * 0.5f);
+    for (const Triangle& t : tris) {
+        targets.push_back((t.v0 + t.v1 + t.v2) * (1.f / 3.f));
+        targets.push_back(t.v0 * 0.7f + t.v1 * 0.2f + t.v2 * 0.1f);
+    }
+    targets.push_back({0.9f, 0.9f, 0.1f});  // off the octahedron
+    std::vector<Vec3> origins;
+    for (int a = 0; a < 6; ++a) origins.push_back(v[a] * 3.f + Vec3{0.01f * a, -0.02f * a, 0.015f * a});
+    for (float x : {-2.5f, 2.5f})
+        for (float y : {-2.f, 2.f})
+            for (float z : {-1.5f, 1.5f}) origins.push_back({x, y, z});
+    std::vector<Ray> rays;
+    for (const Vec3& target : targets)
+        for (const Vec3& o : origins) rays.push_back(Ray{o, 0.f, target - o, kInfinity});
+    const std::size_t from_outside = rays.size();
+    for (const Vec3& target : targets) rays.push_back(Ray{Vec3{0.f, 0.f, 0.f}, 0.f, target, kInfinity});
+    const test::ReferenceAnswers outside = test::compute_reference(tris, rays);
+    for (std::size_t i = 0; i < from_outside; ++i)
+        if (outside.hits[i].is_hit()) rays.push_back(Ray{rays[i].org, 0.f, rays[i].dir, outside.hits[i].t});
+    const test::ReferenceAnswers ref = test::compute_reference(tris, rays);
+    std::size_t hit = 0;
+    for (const Hit& h : ref.hits) hit += h.is_hit();
+    ASSERT_GT(hit, rays.size() / 2);
+    for (detail::Isa isa : detail::available_isas()) {
+        const std::string config = std::string("bvh:packet+") + detail::to_string(isa);
+        const auto accel = make_accelerator(tris, parse_accel_config(config));
+        for (std::size_t batch : {std::size_t{8}, std::size_t{16}, rays.size()})
+            EXPECT_EQ(differing_answers(*accel, rays, ref, batch), 0u) << config << ", batches of " << batch;
+    }
+}
+
 // The router's streams are a view of its BVH's tree, not a second build; any other accelerator is
 // refused.
 TEST(Bvh, StreamViewSharesTheTree) {
