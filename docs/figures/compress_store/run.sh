@@ -71,3 +71,19 @@ if [ -n "$B_PAIRS16" ]; then
     --rays ao --repeats 5 --builds 1 --size 256x256 --clock cpu
 fi
 mkdir -p $D/state_head && bench/incoherent_state.sh $D/state_head && python3 docs/figures/kd_octant/state/kd_branched_ratio.py $D/state_head > $D/state_head/kd_branched_ratio.txt   # at the round's last code commit
+# leaf_lanes/: the packets' leaves tested in the rays' lanes (B_LL, 'as many rays as triangles') against
+# the build before it (B_BEFORE_LL); B_LL2 the same with 'twice as many':
+if [ -n "$B_LL" ]; then
+  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --json $D/leaf_lanes/callgrind_frame.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza bunny --configs bvh:packet --rays frame --size 128x128 --repeats 1 --builds 1
+  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --json $D/leaf_lanes/callgrind_ao.json -- \
+    --scenes-dir ../shared/scenes --scenes sponza sibenik --configs bvh:packet --rays ao --size 128x128 --repeats 1 --builds 1
+  for k in frame ao diffuse; do
+    python3 bench/ab_compare.py "$B_BEFORE_LL" "$B_LL" --rounds 3 --json $D/leaf_lanes/time_$k.json -- \
+      --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
+      --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/leaf_lanes/time_$k.md
+    python3 bench/ab_compare.py "$B_LL" "$B_LL2" --rounds 3 --json $D/leaf_lanes/time_ll2_vs_ll1_$k.json -- \
+      --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
+      --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu
+  done
+fi
