@@ -20,6 +20,7 @@ for s in ao diffuse; do
     --configs embree:single embree:packet8 embree:packet16 auto bvh:packet --dispatch pull --packets 16 \
     --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/two_workers/scaling_$s.json
 done
+python3 $D/two_workers/table.py > $D/two_workers/table.md
 # mask_compare_*: the packets' box test's bits straight from the compare (bits_le), the binary before
 # it (BEFORE_MASK, the push change alone) against the new one, two rounds:
 if [ -n "$BEFORE_MASK" ]; then
@@ -87,3 +88,13 @@ if [ -n "$B_LL" ]; then
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu
   done
 fi
+# state_final/, two_workers_final/: the state and the whole frames at the round's last code commit.
+mkdir -p $D/state_final $D/two_workers_final
+bench/incoherent_state.sh $D/state_final
+python3 docs/figures/kd_octant/state/kd_branched_ratio.py $D/state_final > $D/state_final/kd_branched_ratio.txt
+for s in ao diffuse; do
+  build/bench/cellrt_scaling --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
+    --configs embree:single embree:packet8 embree:packet16 auto bvh:packet --dispatch pull --packets 16 \
+    --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/two_workers_final/scaling_$s.json
+done
+python3 $D/two_workers/table.py $D/two_workers_final > $D/two_workers_final/table.md

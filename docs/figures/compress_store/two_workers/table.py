@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """Whole frames (cellrt_scaling, 384 x 384, AO and diffuse): Embree's fastest of its single rays and
-packets of eight and sixteen over auto's and bvh:packet's frame time, one and two workers."""
+packets of eight and sixteen over auto's and bvh:packet's frame time, one and two workers.
+
+    table.py [FOLDER]    (the folder of scaling_ao.json and scaling_diffuse.json; default: this one)"""
 import json
 import os
+import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
 SCENES = ['sponza', 'sibenik', 'bunny', 'teapot']
 print('| shading | workers | config | ' + ' | '.join(SCENES) + ' |\n|---|--:|---|' + '--:|' * len(SCENES))
 for sh in ['ao', 'diffuse']:
