@@ -192,9 +192,10 @@ thread_local std::array<RoutedAccelerator::LastPath, 4> RoutedAccelerator::last_
 
 }  // namespace
 
-// Sixteen pairs tell a batch of camera or shadow rays (a mean cosine near 1) from AO rays and bounces
-// (below 0.6) as well as 64 did, for a quarter of the work: 64 pairs held 3.1 % of `perf`'s samples
-// of `auto` on the teapot's random rays, 16 hold 1.2 % (docs/INCOHERENT.md, "Twenty-first round").
+// Every (n - 1) / kPairs-th pair, 17 of a batch of 256 rays, tells a batch of camera or shadow rays
+// (a mean cosine near 1) from AO rays and bounces (below 0.6) as kPairs = 64 (85 pairs) did, for a
+// fifth of the work: those held 3.1 % of `perf`'s samples of `auto` on the teapot's random rays,
+// these 1.2 % (docs/INCOHERENT.md, "Twenty-first round").
 float batch_coherence(std::span<const Ray> rays) {
     constexpr std::size_t kPairs = 16;
     if (rays.size() < 2) return 1.f;

@@ -71,7 +71,7 @@ if [ -n "$B_PAIRS16" ]; then
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
     --rays ao --repeats 5 --builds 1 --size 256x256 --clock cpu
 fi
-mkdir -p $D/state_head && bench/incoherent_state.sh $D/state_head && python3 docs/figures/kd_octant/state/kd_branched_ratio.py $D/state_head > $D/state_head/kd_branched_ratio.txt   # at the round's last code commit
+mkdir -p $D/state_head && bench/incoherent_state.sh $D/state_head && python3 docs/figures/kd_octant/state/kd_branched_ratio.py $D/state_head > $D/state_head/kd_branched_ratio.txt   # at 148811a, before the packets' leaves in lanes
 # leaf_lanes/: the packets' leaves tested in the rays' lanes (B_LL, 'as many rays as triangles') against
 # the build before it (B_BEFORE_LL); B_LL2 the same with 'twice as many':
 if [ -n "$B_LL" ]; then
