@@ -98,3 +98,6 @@ for s in ao diffuse; do
     --workers 1 2 --repeats 7 --size 384x384 --shading $s --json $D/two_workers_final/scaling_$s.json
 done
 python3 $D/two_workers/table.py $D/two_workers_final > $D/two_workers_final/table.md
+# leaf_lanes/callgrind_half_vs_kept.json: the lanes from half as many rays as triangles (B_LL_HALF):
+[ -n "$B_LL_HALF" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_LL_HALF" --json $D/leaf_lanes/callgrind_half_vs_kept.json -- \
+  --scenes-dir ../shared/scenes --scenes sponza bunny --configs bvh:packet --rays frame --size 128x128 --repeats 1 --builds 1
