@@ -142,36 +142,10 @@ inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
 // triangle, with t, u, v.
 inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u, F& v) {
-    const float *a = leaf.v[0][0], *b = leaf.v[1][0], *c = leaf.v[2][0];
-    const F a_kz = load(a + r.kz) - r.oz, b_kz = load(b + r.kz) - r.oz, c_kz = load(c + r.kz) - r.oz;
-    const F ax = (load(a + r.kx) - r.ox) - r.sx * a_kz, ay = (load(a + r.ky) - r.oy) - r.sy * a_kz;
-    const F bx = (load(b + r.kx) - r.ox) - r.sx * b_kz, by = (load(b + r.ky) - r.oy) - r.sy * b_kz;
-    const F cx = (load(c + r.kx) - r.ox) - r.sx * c_kz, cy = (load(c + r.ky) - r.oy) - r.sy * c_kz;
-    F eu = cx * by - cy * bx;
-    F ev = ax * cy - ay * cx;
-    F ew = bx * ay - by * ax;
+    const int offset[3] = {r.kx, r.ky, r.kz};
     const I used = splat_i(static_cast<std::int32_t>(count)) > I{0, 1, 2, 3, 4, 5, 6, 7};
-    const I zero = used & ((eu == 0.f) | (ev == 0.f) | (ew == 0.f));
-    if (any(zero)) {
-        for (int i = 0; i < kLanes; ++i) {
-            if (zero[i] == 0) continue;
-            eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
-            ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
-            ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
-        }
-    }
-    const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
-    const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
-    const F det = eu + ev + ew;
-    const F az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
-    const F big_t = eu * az + ev * bz + ew * cz;
-    const F inv_det = splat(1.f) / det;
-    t = big_t * inv_det;
-    u = ev * inv_det;
-    v = ew * inv_det;
-    // t's finiteness (triangle.hpp) comes from the queries' bounds, finite floats (finite_tnear and
-    // finite_tfar, kernel/traversal.hpp): an infinite or NaN t fails the acceptance that follows.
-    return used & ~(negative & positive) & det_in_range_lanes(det);
+    return watertight_in_lanes([&](int k, int role) { return load(leaf.v[k][0] + offset[role]); }, r.ox, r.oy, r.oz,
+                               r.sx, r.sy, r.sz, used, t, u, v);
 }
 
 // The smallest of eight lanes, floats or integers.

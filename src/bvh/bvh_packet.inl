@@ -67,9 +67,10 @@ inline unsigned packet_meets(const BvhNode& node, int k, const RayLanes& p, F cu
 // A leaf's triangles against the packet's rays `rays`, one triangle at a time in every ray's lane (as
 // Embree's packet kernels test a packet against a leaf's triangles), where test_leaf takes one ray at
 // a time with the triangles in lanes: with more rays than triangles at the leaf, fewer passes. Each
-// lane runs watertight_leaf's operations in its order on its own ray's constants (`w`, the packet's
-// WatertightLanes: its origin in its own axis order and its shear) and the triangle's coordinates
-// picked in that order, so t, u and v carry the scalar test's bits; the hit rule then updates each
+// lane runs the watertight test in lanes (watertight_in_lanes, simd/ray_lanes.inl, as
+// watertight_leaf) on its own ray's constants (`w`, the packet's WatertightLanes: its origin in its
+// own axis order and its shear) and the triangle's coordinates picked in that order, so t, u and v
+// carry the scalar test's bits; the hit rule then updates each
 // ray's query, triangle after triangle, which picks the same hit as test_leaf's minimum over the
 // lanes (the rule is a total order). Returns the rays an any-hit query answered.
 template <class Query, class Counters>
@@ -83,7 +84,7 @@ unsigned test_leaf_lanes(const BvhLeaf& leaf, std::uint32_t count, const Waterti
     const I used = met_mask(rays);
     unsigned answered = 0;
     for (std::uint32_t j = 0; j < count; ++j) {
-        // Vertex k's coordinates on each lane's kx, ky and kz axes.
+        // Vertex k's coordinates on each lane's kx, ky and kz axes (role 0, 1, 2).
         F vx[3], vy[3], vz[3];
         for (int k = 0; k < 3; ++k) {
             const F v0 = splat(leaf.v[k][0][j]), v1 = splat(leaf.v[k][1][j]), v2 = splat(leaf.v[k][2][j]);
@@ -91,30 +92,11 @@ unsigned test_leaf_lanes(const BvhLeaf& leaf, std::uint32_t count, const Waterti
             vy[k] = select(y0, v0, select(y1, v1, v2));
             vz[k] = select(z0, v0, select(z1, v1, v2));
         }
-        const F a_kz = vz[0] - w.org[2], b_kz = vz[1] - w.org[2], c_kz = vz[2] - w.org[2];
-        const F ax = (vx[0] - w.org[0]) - w.shear[0] * a_kz, ay = (vy[0] - w.org[1]) - w.shear[1] * a_kz;
-        const F bx = (vx[1] - w.org[0]) - w.shear[0] * b_kz, by = (vy[1] - w.org[1]) - w.shear[1] * b_kz;
-        const F cx = (vx[2] - w.org[0]) - w.shear[0] * c_kz, cy = (vy[2] - w.org[1]) - w.shear[1] * c_kz;
-        F eu = cx * by - cy * bx;
-        F ev = ax * cy - ay * cx;
-        F ew = bx * ay - by * ax;
-        const I zero = used & ((eu == 0.f) | (ev == 0.f) | (ew == 0.f));
-        if (any(zero)) {
-            for (int i = 0; i < kLanes; ++i) {
-                if (zero[i] == 0) continue;
-                eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
-                ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
-                ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
-            }
-        }
-        const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
-        const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
-        const F det = eu + ev + ew;
-        const F az = w.shear[2] * a_kz, bz = w.shear[2] * b_kz, cz = w.shear[2] * c_kz;
-        const F big_t = eu * az + ev * bz + ew * cz;
-        const F inv_det = splat(1.f) / det;
-        const F t = big_t * inv_det;
-        const I hit = used & ~(negative & positive) & det_in_range_lanes(det) & (t >= tnear);
+        const auto coord = [&](int k, int role) { return role == 0 ? vx[k] : role == 1 ? vy[k] : vz[k]; };
+        F t, u, v;
+        const I hit = watertight_in_lanes(coord, w.org[0], w.org[1], w.org[2], w.shear[0], w.shear[1], w.shear[2], used,
+                                          t, u, v) &
+                      (t >= tnear);
         unsigned hits = bits(hit);
         if (!hits) continue;
         const std::uint32_t prim = leaf.prim[j];
@@ -125,7 +107,6 @@ unsigned test_leaf_lanes(const BvhLeaf& leaf, std::uint32_t count, const Waterti
             }
             if (answered == rays) break;
         } else {
-            const F u = ev * inv_det, v = ew * inv_det;
             for (; hits; hits &= hits - 1) {
                 const int i = __builtin_ctz(hits);
                 if (closer(t[i], prim, q[i].best)) {

@@ -108,34 +108,8 @@ inline I watertight_lanes(const Lanes& L, int perm, const Triangle& tri, I mask,
         if (perm >= 0) return splat(p[static_cast<std::size_t>(axis[role])]);
         return pick(L.is_x[role], L.is_y[role], splat(p.x), splat(p.y), splat(p.z));
     };
-    const F ox = L.role_org[0], oy = L.role_org[1], oz = L.role_org[2];
-    const F a_kz = coord(tri.v0, 2) - oz, b_kz = coord(tri.v1, 2) - oz, c_kz = coord(tri.v2, 2) - oz;
-    const F ax = (coord(tri.v0, 0) - ox) - L.sx * a_kz, ay = (coord(tri.v0, 1) - oy) - L.sy * a_kz;
-    const F bx = (coord(tri.v1, 0) - ox) - L.sx * b_kz, by = (coord(tri.v1, 1) - oy) - L.sy * b_kz;
-    const F cx = (coord(tri.v2, 0) - ox) - L.sx * c_kz, cy = (coord(tri.v2, 1) - oy) - L.sy * c_kz;
-    F eu = cx * by - cy * bx;
-    F ev = ax * cy - ay * cx;
-    F ew = bx * ay - by * ax;
-    const I zero = mask & ((eu == 0.f) | (ev == 0.f) | (ew == 0.f));
-    if (any(zero)) {
-        for (int i = 0; i < kLanes; ++i) {
-            if (zero[i] == 0) continue;
-            eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
-            ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
-            ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
-        }
-    }
-    const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
-    const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
-    const F det = eu + ev + ew;
-    const F az = L.sz * a_kz, bz = L.sz * b_kz, cz = L.sz * c_kz;
-    const F big_t = eu * az + ev * bz + ew * cz;
-    const F inv_det = splat(1.f) / det;
-    t = big_t * inv_det;
-    u = ev * inv_det;
-    v = ew * inv_det;
-    // t's finiteness (triangle.hpp) comes from the callers' bounds, clamped to the finite floats.
-    return mask & ~(negative & positive) & det_in_range_lanes(det);
+    return watertight_in_lanes([&](int k, int role) { return coord(k == 0 ? tri.v0 : k == 1 ? tri.v1 : tri.v2, role); },
+                               L.role_org[0], L.role_org[1], L.role_org[2], L.sx, L.sy, L.sz, mask, t, u, v);
 }
 
 // The permutation the lanes of `mask` share, or -1 when they differ.

@@ -16,6 +16,47 @@ inline I det_in_range_lanes(F det) {
     return (a >= splat(kLeastNormal)) & (a < splat(kInfinity));
 }
 
+// The watertight test (triangle.hpp) in lanes: coord(k, role) gives vertex k's coordinate on each
+// lane's ray's kx, ky or kz axis (role 0, 1, 2), read where it is used; (ox, oy, oz) the ray's origin
+// on those axes and (sx, sy, sz) its shear. Each lane runs the scalar test's operations in their
+// order, so t, u and v carry its bits; an edge function of exactly zero (a ray through an edge or a
+// vertex) is recomputed in double precision as the scalar test does. Returns the lanes of `used`
+// whose ray meets its triangle; t's finiteness is left to the callers' bounds, which are finite
+// floats (kernel/traversal.hpp). The lanes by reference, read where they are used: taken by value,
+// they were all loaded before the test and the AVX2 kernels spilled. One copy for the kd-tree's and the BIH's packets
+// (packet_kernels.inl), the wide BVH's leaves (bvh_kernels.inl) and its packets' leaves
+// (bvh_packet.inl).
+template <class Coord>
+[[gnu::always_inline]] inline I watertight_in_lanes(Coord&& coord, const F& ox, const F& oy, const F& oz, const F& sx,
+                                                    const F& sy, const F& sz, const I& used, F& t, F& u, F& v) {
+    const F a_kz = coord(0, 2) - oz, b_kz = coord(1, 2) - oz, c_kz = coord(2, 2) - oz;
+    const F ax = (coord(0, 0) - ox) - sx * a_kz, ay = (coord(0, 1) - oy) - sy * a_kz;
+    const F bx = (coord(1, 0) - ox) - sx * b_kz, by = (coord(1, 1) - oy) - sy * b_kz;
+    const F cx = (coord(2, 0) - ox) - sx * c_kz, cy = (coord(2, 1) - oy) - sy * c_kz;
+    F eu = cx * by - cy * bx;
+    F ev = ax * cy - ay * cx;
+    F ew = bx * ay - by * ax;
+    const I zero = used & ((eu == 0.f) | (ev == 0.f) | (ew == 0.f));
+    if (any(zero)) {
+        for (int i = 0; i < kLanes; ++i) {
+            if (zero[i] == 0) continue;
+            eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
+            ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
+            ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
+        }
+    }
+    const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
+    const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
+    const F det = eu + ev + ew;
+    const F az = sz * a_kz, bz = sz * b_kz, cz = sz * c_kz;
+    const F big_t = eu * az + ev * bz + ew * cz;
+    const F inv_det = splat(1.f) / det;
+    t = big_t * inv_det;
+    u = ev * inv_det;
+    v = ew * inv_det;
+    return used & ~(negative & positive) & det_in_range_lanes(det);
+}
+
 // TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the
 // finite floats. Lanes of invalid rays (ray.hpp) and lanes past n hold a harmless ray (origin 0,
 // direction (1, 1, 1)) and are not in `valid`.

@@ -101,3 +101,6 @@ python3 $D/two_workers/table.py $D/two_workers_final > $D/two_workers_final/tabl
 # leaf_lanes/callgrind_half_vs_kept.json: the lanes from half as many rays as triangles (B_LL_HALF):
 [ -n "$B_LL_HALF" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_LL_HALF" --json $D/leaf_lanes/callgrind_half_vs_kept.json -- \
   --scenes-dir ../shared/scenes --scenes sponza bunny --configs bvh:packet --rays frame --size 128x128 --repeats 1 --builds 1
+# leaf_lanes/callgrind_one_copy.json: one copy of the watertight test in lanes (B_ONE_COPY) against B_LL:
+[ -n "$B_ONE_COPY" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_ONE_COPY" --json $D/leaf_lanes/callgrind_one_copy.json -- \
+  --scenes-dir ../shared/scenes --scenes sponza --configs bvh:packet bvh kd+auto --rays frame --size 128x128 --repeats 1 --builds 1
