@@ -142,10 +142,12 @@ inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
 // triangle, with t, u, v.
 inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u, F& v) {
+    // Each vertex's rows from its first (its x row): the ray's axis order picks a row by offset.
+    const float* vertex[3] = {leaf.v[0][0], leaf.v[1][0], leaf.v[2][0]};
     const int offset[3] = {r.kx, r.ky, r.kz};
     const I used = splat_i(static_cast<std::int32_t>(count)) > I{0, 1, 2, 3, 4, 5, 6, 7};
-    return watertight_in_lanes([&](int k, int role) { return load(leaf.v[k][0] + offset[role]); }, r.ox, r.oy, r.oz,
-                               r.sx, r.sy, r.sz, used, t, u, v);
+    return watertight_in_lanes([&](int k, int role) { return load(vertex[k] + offset[role]); }, r.ox, r.oy, r.oz, r.sx,
+                               r.sy, r.sz, used, t, u, v);
 }
 
 // The smallest of eight lanes, floats or integers.
