@@ -70,9 +70,10 @@ inline unsigned packet_meets(const BvhNode& node, int k, const RayLanes& p, F cu
 // lane runs the watertight test in lanes (watertight_in_lanes, simd/ray_lanes.inl, as
 // watertight_leaf) on its own ray's constants (`w`, the packet's WatertightLanes: its origin in its
 // own axis order and its shear) and the triangle's coordinates picked in that order, so t, u and v
-// carry the scalar test's bits; the hit rule then updates each
-// ray's query, triangle after triangle, which picks the same hit as test_leaf's minimum over the
-// lanes (the rule is a total order). Returns the rays an any-hit query answered.
+// carry the scalar test's bits; the hit rule then updates each ray's query, triangle after
+// triangle, which picks the same hit as test_leaf's minimum over the lanes (the rule is a total
+// order). The axis masks are made once per leaf, not per triangle as pick_axis (ray_lanes.inl)
+// would. Returns the rays an any-hit query answered.
 template <class Query, class Counters>
 unsigned test_leaf_lanes(const BvhLeaf& leaf, std::uint32_t count, const WatertightLanes& w, const F& tnear,
                          unsigned rays, Query* q, F& cull, Counters& c) {
