@@ -95,6 +95,7 @@ struct alignas(64) PreparedRay {
     float leaf_org[3];  // the origin in the watertight test's axis order (kx, ky, kz)
     float shear[3];     // sx, sy, sz
     std::uint32_t code; // bits 0-2: the direction's sign bits (x, y, z); 3-4: kx; 5-6: ky; 7-8: kz
+    std::uint32_t unused;
 
     unsigned octant() const { return code & 7u; }
     BoxRay box() const { return BoxRay(org, inv, code, tnear, margin); }
@@ -104,6 +105,7 @@ struct alignas(64) PreparedRay {
     }
 };
 static_assert(sizeof(PreparedRay) == 64, "a prepared ray is one cache line");
+static_assert(offsetof(PreparedRay, leaf_org) == 32, "prepare_rays writes a prepared ray as two rows of eight");
 
 // The node's child slots that hold a child (not kEmptyChild), as bits.
 inline unsigned node_children(const BvhNode& node) {
@@ -118,23 +120,42 @@ inline LeafRay leaf_ray_of_lane(const Lanes& w, int i) {
     return LeafRay(o, s, w.kx[i], w.ky[i], w.kz[i]);
 }
 
-// Rays [0, n) (n <= kLanes) of a batch prepared in lanes (simd/ray_lanes.inl), written to
-// out[0, n). Returns the lanes of valid rays, as bits.
-inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, PreparedRay* out) {
+// Row i of the result is lane i of each of the eight rows: an 8 x 8 transpose in three rounds of
+// eight shuffles (pairs of rows within each half, then quadruples, then the halves).
+inline void transpose8(F (&m)[8]) {
+    F u[8], v[8];
+    for (int k = 0; k < 8; k += 2) {
+        u[k] = __builtin_shufflevector(m[k], m[k + 1], 0, 8, 1, 9, 4, 12, 5, 13);
+        u[k + 1] = __builtin_shufflevector(m[k], m[k + 1], 2, 10, 3, 11, 6, 14, 7, 15);
+    }
+    for (int h = 0; h < 8; h += 4) {  // v[h + j]: rows h to h + 3 of lanes j and j + 4
+        v[h] = __builtin_shufflevector(u[h], u[h + 2], 0, 1, 8, 9, 4, 5, 12, 13);
+        v[h + 1] = __builtin_shufflevector(u[h], u[h + 2], 2, 3, 10, 11, 6, 7, 14, 15);
+        v[h + 2] = __builtin_shufflevector(u[h + 1], u[h + 3], 0, 1, 8, 9, 4, 5, 12, 13);
+        v[h + 3] = __builtin_shufflevector(u[h + 1], u[h + 3], 2, 3, 10, 11, 6, 7, 14, 15);
+    }
+    for (int j = 0; j < 4; ++j) {
+        m[j] = __builtin_shufflevector(v[j], v[4 + j], 0, 1, 2, 3, 8, 9, 10, 11);
+        m[j + 4] = __builtin_shufflevector(v[j], v[4 + j], 4, 5, 6, 7, 12, 13, 14, 15);
+    }
+}
+
+// Rays [0, n) (n <= kLanes) of a batch prepared in lanes (simd/ray_lanes.inl), written to out[0, n)
+// (the records past n get the empty lanes). Returns the lanes of valid rays, as bits. Each lane's
+// record goes out as two rows of a transpose, where each field of each lane was extracted and
+// stored alone (more than half of prepare_rays' samples on random rays: docs/INCOHERENT.md,
+// "Twenty-second round").
+inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, PreparedRay (&out)[kLanes]) {
     const RayLanes l = load_ray_lanes(rays, n, scene);
     const WatertightLanes w(l);
     const I code = (l.negative[0] & 1) | (l.negative[1] & 2) | (l.negative[2] & 4) | w.kx << 3 | w.ky << 5 | w.kz << 7;
-    for (std::size_t i = 0; i < n; ++i) {
-        PreparedRay& r = out[i];
-        for (int a = 0; a < 3; ++a) {
-            r.org[a] = l.org[a][i];
-            r.inv[a] = l.inv[a][i];
-            r.leaf_org[a] = w.org[a][i];
-            r.shear[a] = w.shear[a][i];
-        }
-        r.tnear = l.tnear[i];
-        r.margin = l.margin[i];
-        r.code = static_cast<std::uint32_t>(code[i]);
+    F front[8] = {l.org[0], l.org[1], l.org[2], l.tnear, l.inv[0], l.inv[1], l.inv[2], l.margin};
+    F back[8] = {w.org[0], w.org[1], w.org[2], w.shear[0], w.shear[1], w.shear[2], reinterpret_cast<F>(code), splat(0.f)};
+    transpose8(front);
+    transpose8(back);
+    for (int i = 0; i < kLanes; ++i) {
+        std::memcpy(&out[i], &front[i], sizeof(F));
+        std::memcpy(&out[i].leaf_org, &back[i], sizeof(F));
     }
     return bits(l.valid);
 }
