@@ -75,6 +75,29 @@ struct type_caster<cellrt::TreeReport> : made_caster<cellrt::TreeReport> {};
 namespace cellrt::python {
 namespace {
 
+// A second `__init__` on an object already made: pybind11 (2.10) skips it and returns None without
+// reading its arguments, so that `acc.__init__(v, f, kind="bvh")` left the old accelerator in place
+// without a word. Each class's `__init__` is wrapped so that such a call raises TypeError; a first
+// call (the class called, or a subclass's `super().__init__`) goes on to pybind11's own.
+template <class T, class... Options>
+void refuse_second_init(py::class_<T, Options...>& cls) {
+    static const std::string doc = py::str(cls.attr("__init__").attr("__doc__"));
+    cls.attr("__init__") = py::cpp_function(
+        [made_by = py::object(cls.attr("__init__")), type = py::object(cls)](py::handle self, py::args args,
+                                                                               py::kwargs kwargs) {
+            if (PyObject_TypeCheck(self.ptr(), reinterpret_cast<PyTypeObject*>(type.ptr()))) {
+                const py::detail::value_and_holder v_h = reinterpret_cast<py::detail::instance*>(self.ptr())
+                    ->get_value_and_holder(py::detail::get_type_info(typeid(T)), false);
+                if (v_h.vh != nullptr && v_h.instance_registered())
+                    throw py::type_error(std::string(Py_TYPE(self.ptr())->tp_name) +
+                                         " object is already made: __init__ runs once; call the class for a new one");
+            }
+            made_by(self, *args, **kwargs);
+        },
+        // Not named __init__: pybind11 takes a function of that name for a constructor and would skip it too.
+        py::name("init_once"), py::is_method(cls), py::doc(doc.c_str()));
+}
+
 std::string param_value(py::handle value, const std::string& name) {
     if (py::isinstance<py::str>(value)) return text(value, name);
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
@@ -295,10 +318,10 @@ PYBIND11_MODULE(cellrt, m) {
                    std::to_string(s.build_seconds) + " s, " + std::to_string(s.memory_bytes) + " bytes>";
         });
 
-    py::class_<PyAccelerator>(m, "Accelerator",
+    py::class_<PyAccelerator> accelerator(m, "Accelerator",
                               "An acceleration structure over triangles. intersect() and occluded() may run at once "
-                              "from any number of Python threads; each releases the GIL while it traces.")
-        .def(py::init([](py::handle first, py::handle faces, py::handle kind, py::handle simd, py::handle threads,
+                              "from any number of Python threads; each releases the GIL while it traces.");
+    accelerator.def(py::init([](py::handle first, py::handle faces, py::handle kind, py::handle simd, py::handle threads,
                          py::handle params, py::handle device) {
                  const AccelConfig config = accel_config(kind, simd, threads, params, device);
                  return build(faces.is_none() ? triangle_soup(first) : indexed_triangles(first, faces), config);
@@ -326,6 +349,7 @@ PYBIND11_MODULE(cellrt, m) {
             return "<cellrt.Accelerator " + format_accel_config(a.config) + " on " + a.config.device + ", " +
                    std::to_string(a.triangles.size()) + " triangles>";
         });
+    refuse_second_init(accelerator);
 
     py::class_<Camera> camera(m, "Camera", "A pinhole camera: position, look_at, up, fov_y_deg (full vertical, degrees)");
     camera.def(py::init<>());
@@ -340,9 +364,11 @@ PYBIND11_MODULE(cellrt, m) {
     light.def(py::init<>());
     vec_property(light, "position", &PointLight::position, "(x, y, z)");
     vec_property(light, "color", &PointLight::color, "(r, g, b)");
+    refuse_second_init(camera);
+    refuse_second_init(light);
 
-    py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", "Triangles, a camera, a point light and an image size")
-        .def(py::init([](py::handle triangles) {
+    py::class_<Scene, std::shared_ptr<Scene>> scene(m, "Scene", "Triangles, a camera, a point light and an image size");
+    scene.def(py::init([](py::handle triangles) {
                  auto s = std::make_shared<Scene>();
                  s->name = "numpy";
                  s->triangles = triangle_soup(triangles);
@@ -372,6 +398,7 @@ PYBIND11_MODULE(cellrt, m) {
             return "<cellrt.Scene '" + s.name + "', " + std::to_string(s.triangles.size()) + " triangles, " +
                    std::to_string(s.width) + "x" + std::to_string(s.height) + ">";
         });
+    refuse_second_init(scene);
 
     m.def("load_scene", &load, py::arg("path"),
           "A view file (.json), a mesh (.obj, .ply, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "

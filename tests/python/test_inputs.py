@@ -249,6 +249,36 @@ def test_an_object_made_by_new_without_init_is_refused(cls):
         assert repr(made[cls]())
 
 
+@pytest.mark.parametrize("make", [lambda: cellrt.Accelerator(TRI, kind="kd"), lambda: cellrt.Scene(TRI),
+                                  cellrt.Camera, cellrt.Light])
+def test_a_second_init_is_refused_and_changes_nothing(make):
+    # pybind11 alone skips a second __init__ and returns None: the object looked rebuilt and was not.
+    obj = make()
+    before = repr(obj) if isinstance(obj, (cellrt.Accelerator, cellrt.Scene)) else None
+    args = {cellrt.Accelerator: ((TRI,), {"kind": "bvh"}), cellrt.Scene: ((TRI[:0],), {})}.get(type(obj), ((), {}))
+    with pytest.raises(TypeError, match="already made: __init__ runs once"):
+        obj.__init__(*args[0], **args[1])
+    if before is not None:
+        assert repr(obj) == before
+
+
+def test_init_runs_once_through_new_and_through_a_subclass():
+    unmade = cellrt.Accelerator.__new__(cellrt.Accelerator)
+    unmade.__init__(TRI, kind="bih")
+    assert unmade.config.startswith("bih")
+
+    class Mine(cellrt.Accelerator):
+        def __init__(self, triangles):
+            super().__init__(triangles, kind="kd:rec")
+            self.label = "mine"
+
+    mine = Mine(TRI)
+    assert mine.config.startswith("kd:rec") and mine.label == "mine"
+    assert mine.intersect(O, D)["prim"].tolist() == cellrt.Accelerator(TRI).intersect(O, D)["prim"].tolist()
+    with pytest.raises(TypeError, match="incompatible constructor arguments"):
+        cellrt.Accelerator(TRI, TRI, TRI)
+
+
 def test_an_unmade_object_is_refused_as_an_argument():
     acc = cellrt.Accelerator.__new__(cellrt.Accelerator)
     for method in (acc.intersect, acc.occluded):
