@@ -373,7 +373,11 @@ PYBIND11_MODULE(cellrt, m) {
                  s->name = "numpy";
                  s->triangles = triangle_soup(triangles);
                  if (s->triangles.empty()) throw py::value_error("triangles must hold at least one triangle");
-                 set_default_view(*s);
+                 try {
+                     set_default_view(*s);
+                 } catch (const Error& e) {
+                     throw py::value_error(std::string("triangles: ") + e.what());
+                 }
                  return s;
              }),
              py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")

@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
 #include "cellrt/scene.hpp"
@@ -193,6 +194,34 @@ TEST_F(LoaderTest, EmptyMeshIsAnError) {
         EXPECT_TRUE(load_obj(path).empty());
         EXPECT_EQ(error_of([&] { load_scene(path); }), path + ": the mesh has no triangles") << text;
     }
+}
+
+// A bare mesh is shown by the default view; where that view cannot be made in float (a camera past
+// float's range, an extent whose length overflows, a mesh too small for its distance from the
+// origin), the message names the mesh's span, not a camera the user never gave. Below 1e18 a mesh
+// around the origin is framed as before.
+TEST_F(LoaderTest, MeshTooLargeForTheDefaultViewIsNamed) {
+    const std::string remedy = "; give it a view file with its own camera and light (docs/SCENES.md)";
+    struct Case {
+        const char* text;
+        const char* span;
+    };
+    for (const Case& c : {Case{"v 1e38 1e38 1e38\nv -1e38 -1e38 -1e38\nv 1e38 -1e38 0\nf 1 2 3\n",
+                               "(-9.99999968e+37, -9.99999968e+37, -9.99999968e+37) to (9.99999968e+37, 9.99999968e+37, "
+                               "9.99999968e+37)"},
+                          Case{"v 5e18 5e18 5e18\nv -5e18 -5e18 -5e18\nv 5e18 -5e18 0\nf 1 2 3\n",
+                               "(-4.99999999e+18, -4.99999999e+18, -4.99999999e+18) to (4.99999999e+18, 4.99999999e+18, "
+                               "4.99999999e+18)"},
+                          Case{"v 1e30 1e30 1e30\nv 1.000001e30 1e30 1e30\nv 1e30 1.000001e30 1e30\nf 1 2 3\n",
+                               "(1.00000002e+30, 1.00000002e+30, 1.00000002e+30) to (1.000001e+30, 1.000001e+30, "
+                               "1.00000002e+30)"}}) {
+        const std::string path = write("huge.obj", c.text);
+        EXPECT_EQ(error_of([&] { load_scene(path); }),
+                  path + ": the mesh spans " + c.span + ", which the default view cannot frame in float arithmetic" +
+                      remedy);
+    }
+    const Scene framed = load_scene(write("large.obj", "v 1e18 1e18 1e18\nv -1e18 -1e18 -1e18\nv 1e18 -1e18 0\nf 1 2 3\n"));
+    EXPECT_NO_THROW(PinholeCamera(framed.camera, 8, 8));
 }
 
 TEST_F(LoaderTest, MeshFormatFollowsTheExtensionInAnyCase) {

@@ -39,7 +39,9 @@ struct Scene {
 Scene load_scene(const std::string& spec);
 
 // A camera looking at the whole of `bounds` from the front-upper-right and a light above it; used
-// for bare meshes.
+// for bare meshes. Throws cellrt::Error when that view cannot be made in float arithmetic: for a
+// mesh around the origin, from coordinates of about 4e18 on (the camera's distance, squared,
+// overflows), or for a mesh too small for its distance from the origin.
 void set_default_view(Scene& scene);
 
 // Checks what every loader guarantees: at least one triangle, all coordinates finite, a valid camera

@@ -188,6 +188,17 @@ def test_bad_scene_files(tmp_path):
     refused("path must not contain a NUL character", cellrt.load_scene, "a\x00b.obj")
 
 
+def test_triangles_too_large_for_the_default_view():
+    # The default view's camera would lie beyond float's range: said when the scene is made, with
+    # the mesh's span, not later as a camera the caller never gave. 1e18 is still framed.
+    for x in (1e38, 5e18):
+        huge = np.array([[[x, x, x], [-x, -x, -x], [x, -x, 0]]], np.float32)
+        refused(r"triangles: the mesh spans \(-.*\), which the default view cannot frame in float arithmetic",
+                cellrt.Scene, huge)
+    large = np.array([[[1e18, 1e18, 1e18], [-1e18, -1e18, -1e18], [1e18, -1e18, 0]]], np.float32)
+    assert cellrt.render(cellrt.Scene(large), size=(4, 4)).shape == (4, 4, 3)
+
+
 def test_bad_render_arguments(tmp_path):
     scene = cellrt.Scene(TRI)
     refused("scene must be a cellrt.Scene", cellrt.render, "builtin:city")
