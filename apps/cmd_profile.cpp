@@ -304,6 +304,7 @@ Runner add_profile(CLI::App& app) {
                                               "(docs/PROFILE.md)");
     cmd->add_option("scene", o->scene, scene_help())->required();
     o->accel.add_to(*cmd, false);
+    o->accel.threads_option->description("Build threads (0: all cores); the profiled frame renders on one thread");
     cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT (default: the view file's; 128x128 under callgrind)")
         ->check(non_empty());
     cmd->add_option("--packet", o->packet, "Packet edge P: the renderer traces P x P rays at a time")

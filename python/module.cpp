@@ -82,6 +82,10 @@ namespace {
 template <class T, class... Options>
 void refuse_second_init(py::class_<T, Options...>& cls) {
     static const std::string doc = py::str(cls.attr("__init__").attr("__doc__"));
+    // The wrapper's own signature line, init_once(self, *args, **kwargs), would come first in help():
+    // the docstring is pybind11's own for the wrapped __init__, signature line included.
+    py::options no_signature;
+    no_signature.disable_function_signatures();
     cls.attr("__init__") = py::cpp_function(
         [made_by = py::object(cls.attr("__init__")), type = py::object(cls)](py::handle self, py::args args,
                                                                                py::kwargs kwargs) {
@@ -356,7 +360,26 @@ PYBIND11_MODULE(cellrt, m) {
     vec_property(camera, "position", &Camera::position, "(x, y, z)");
     vec_property(camera, "look_at", &Camera::look_at, "(x, y, z)");
     vec_property(camera, "up", &Camera::up, "(x, y, z)");
-    camera.def_readwrite("fov_y_deg", &Camera::fov_y_deg)
+    // Checked when set, as position, look_at and up are, by the rule PinholeCamera applies at render.
+    camera.def_property("fov_y_deg", [](const Camera& c) { return c.fov_y_deg; },
+                        [](Camera& c, py::handle value) {
+                            const auto refuse = [&] {
+                                throw py::value_error("fov_y_deg must be a number in (0, 180), got " +
+                                                      py::repr(value).cast<std::string>());
+                            };
+                            if (py::isinstance<py::bool_>(value) || PyNumber_Check(value.ptr()) == 0 ||
+                                PyComplex_Check(value.ptr()))
+                                refuse();
+                            const double d = PyFloat_AsDouble(value.ptr());
+                            if (d == -1.0 && PyErr_Occurred()) {
+                                PyErr_Clear();
+                                refuse();
+                            }
+                            const float f = static_cast<float>(d);
+                            if (!(f > 0.f && f < 180.f)) refuse();
+                            c.fov_y_deg = f;
+                        },
+                        "full vertical field of view in degrees, in (0, 180)")
         .def("rays", &camera_rays, py::arg("width"), py::arg("height"),
                  "The primary rays of a width x height image, as the renderer casts them: (origins, directions), "
                  "each (width*height, 3) float32, row-major from the top row.");
@@ -405,7 +428,7 @@ PYBIND11_MODULE(cellrt, m) {
     refuse_second_init(scene);
 
     m.def("load_scene", &load, py::arg("path"),
-          "A view file (.json), a mesh (.obj, .ply, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "
+          "A view file (.json), a mesh (.obj, .ply, .gltf, .glb, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "
           "cellrt.Error with the library's message naming the file and line.");
     m.def("render", &render_scene, py::arg("scene"), py::kw_only(), py::arg("kind") = py::none(),
           py::arg("size") = py::none(), py::arg("shading") = "direct", py::arg("threads") = 0, py::arg("ao_samples") = 4,

@@ -10,8 +10,9 @@
  *
  * Errors. Every function that can fail returns a cellrt_error (or NULL for a handle) and records the
  * error for the calling thread on the device concerned, then calls the device's error function if one
- * is set. An error with no device to go to (a NULL or invalid device handle) is recorded for the calling
- * thread under the NULL device. No C++ exception leaves any function.
+ * is set. An error with no device to go to (a NULL or invalid device, scene or accelerator handle,
+ * and every refused retain or release) is recorded for the calling thread under the NULL device and
+ * calls no error function. No C++ exception leaves any function.
  *
  * Thread safety. Every function may be called from any number of threads at once. intersect and
  * occluded calls may run at once on one accelerator and each gets the answers it gets alone; they must
@@ -119,7 +120,8 @@ CELLRT_API cellrt_error cellrt_scene_get_info(cellrt_scene scene, size_t* triang
 /* Accelerators: a structure built over `scene` from a configuration string
  * KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd", "bih:branchless", "kd+auto@leaf_size=2", "brute";
  * NULL is the library's default, "auto@packets=bvh" (one wide BVH, each batch on its fastest traversal;
- * "kd" on "cuda" below). Its kinds, traversals and parameters are those of `cellrt list`. */
+ * "kd" on "cuda" below). Its kinds, traversals and parameters are those `cellrt info --params KIND`
+ * lists. */
 CELLRT_API cellrt_accel cellrt_accel_new(cellrt_scene scene, const char* config);
 /* The same, traced where `where` says: "cpu" (or NULL), as cellrt_accel_new; "cuda": the tree built on
  * the host and traced on the GPU, one ray per GPU thread (kinds kd and bih, no SIMD set; docs/GPU.md).

@@ -259,7 +259,8 @@ cellrt_error cellrt_device_set_error_function(cellrt_device device, cellrt_error
 
 cellrt_error cellrt_device_get_error(cellrt_device device, const char** message) {
     // Records are kept by id, so a handle that was never live has none, and one released keeps the
-    // calling thread's last error on it (such as a release too many).
+    // calling thread's last error recorded on it while it lived (a release too many is recorded
+    // under NULL: a dead handle has no device).
     auto& all = records();
     const auto it = all.find(id_of(device));
     if (it == all.end()) {

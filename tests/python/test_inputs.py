@@ -223,6 +223,13 @@ def test_bad_scene_properties():
     refused(r"up = \(0.0, nan, 0.0\) is not finite", setattr, scene.camera, "up", (0, np.nan, 0))
     refused("color must hold real numbers", setattr, scene.light, "color", ("r", "g", "b"))
     refused(r"size\[1\] must be an integer", setattr, scene, "size", (5, 2.5))
+    # The field of view is checked when set, as the vectors are, not first at render; 179.99999999
+    # is 180 as a float32, the camera's type.
+    for fov in (np.nan, 0, 180, 179.99999999, -5, np.inf, "45", True, None, 1j):
+        refused(r"fov_y_deg must be a number in \(0, 180\), got ", setattr, scene.camera, "fov_y_deg", fov)
+    camera = cellrt.Camera()
+    camera.fov_y_deg = np.float32(30)
+    assert camera.fov_y_deg == 30.0
     refused("triangles must hold at least one triangle", cellrt.Scene, np.zeros((0, 3, 3)))
     with pytest.raises(ValueError):
         scene.triangles[0, 0, 0] = 5.0
