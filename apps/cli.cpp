@@ -123,32 +123,6 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
     return accel;
 }
 
-void check_output(const std::string& path, bool overwrite) {
-    std::error_code ec;  // a path the system cannot look up is refused when it is written
-    if (!overwrite && std::filesystem::exists(path, ec))
-        throw Error(path + ": file exists (pass --overwrite to replace it)");
-    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-    if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
-        throw Error(path + ": no folder " + folder.string() + " to write it in");
-}
-
-// A path as the file it names: links and dots resolved where the system can, else as written.
-static std::filesystem::path file_named(const std::string& path) {
-    std::error_code ec;
-    const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
-    return ec ? std::filesystem::absolute(path, ec).lexically_normal() : p;
-}
-
-void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
-    for (std::size_t i = 0; i < outputs.size(); ++i)
-        for (std::size_t j = 0; j < i; ++j) {
-            const auto& [a_option, a] = outputs[j];
-            const auto& [b_option, b] = outputs[i];
-            if (!a.empty() && !b.empty() && file_named(a) == file_named(b))
-                throw Error(b_option + " " + b + " names the same file as " + a_option + " " + a);
-        }
-}
-
 void check_threads(unsigned threads) {
     if (threads > kMaxWorkers)
         throw Error("--threads " + std::to_string(threads) + " must lie in [0, " + std::to_string(kMaxWorkers) + "]");

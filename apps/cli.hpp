@@ -66,11 +66,6 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
 
 void print_stats(const AccelStats& s);
 
-// Refuses at the start, before any work, to replace a file the user has (unless `overwrite`), or to
-// write into a folder that is not there.
-void check_output(const std::string& path, bool overwrite);
-// Refuses two outputs (option, path) that name one file: the second would replace the first.
-void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 // A CLI11 check that refuses an empty value (an option given as "" means no default).
 CLI::Validator non_empty();
 

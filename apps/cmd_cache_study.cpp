@@ -371,11 +371,10 @@ Runner add_cache_study(CLI::App& app) {
             csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
             md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
             if (cluster::leader()) {
+                check_output_folder("--out", o->out);
                 std::error_code ec;
-                std::filesystem::create_directories(o->out, ec);
-                if (!std::filesystem::is_directory(o->out, ec))
-                    throw Error("--out '" + o->out + "': cannot create the folder");
-                for (const std::string& p : {csv_path, md_path}) check_output(p, o->overwrite);
+                if (std::filesystem::is_directory(o->out, ec))
+                    for (const std::string& p : {csv_path, md_path}) check_output_file(p, o->overwrite);
             }
         }, "checking the options");
         const unsigned threads = o->threads ? o->threads : cluster::cores();
@@ -443,6 +442,9 @@ Runner add_cache_study(CLI::App& app) {
             for (const std::string& key : group_order) md += best_layout_line(scene.name, runs, results, groups[key]);
         }
         if (!cluster::leader()) return 0;
+        std::error_code ec;
+        std::filesystem::create_directories(o->out, ec);
+        if (!std::filesystem::is_directory(o->out, ec)) throw Error("--out '" + o->out + "': cannot create the folder");
         write_file_atomically(csv_path, csv, o->overwrite);
         write_file_atomically(md_path, md, o->overwrite);
         std::printf("\n%s\nwrote %s and %s in %.1f s; draw the graphs with:\n"

@@ -204,9 +204,9 @@ Runner add_render(CLI::App& app) {
             if (o->local_store.enabled && cluster::ranks() > 1)
                 throw Error("--local-store models one process's workers: run it with cellrt, not under mpirun");
             if (cluster::leader()) {
-                check_output(o->out, o->overwrite);
-                if (!o->stats.empty()) check_output(o->stats, o->overwrite);
-                check_distinct_outputs({{"-o", o->out}, {"--stats", o->stats}});
+                check_output_file(o->out, o->overwrite);
+                if (!o->stats.empty()) check_output_file(o->stats, o->overwrite);
+                check_distinct_files({{"-o", o->out}, {"--stats", o->stats}}, {{"scene", o->scene}});
             }
         }, "checking the options");
         Timer load_timer;

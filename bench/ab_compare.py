@@ -17,14 +17,13 @@ import tempfile
 
 
 def run(binary, args):
-    with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as f:
-        path = f.name
-    try:
+    # A path that does not exist yet: cellrt_bench refuses to replace a file without --overwrite,
+    # which older binaries, also compared here, do not take.
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "run.json")
         subprocess.run([binary, *args, "--json", path], check=True, stdout=subprocess.DEVNULL)
         with open(path) as f:
             return json.load(f)
-    finally:
-        os.unlink(path)
 
 
 def main():

@@ -92,6 +92,8 @@ struct Options {
     int repeats = 5, builds = 3, batch = 256, ao_samples = ShadingOptions{}.ao_samples;
     unsigned threads = 1;
     std::string size, json_path, clock = "wall", ray_kind = "frame";
+    bool overwrite = false;
+    bool scenes_named = false;  // --scenes given: a scene not found is an error, not skipped
 };
 
 // Reads the command line into `o`; returns the exit status where the program ends there (--help, a bad
@@ -107,6 +109,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--threads", o.threads, "Build threads (tracing is single-threaded)")->capture_default_str();
     app.add_option("--size", o.size, "Image size WxH (default: the view file's)");
     app.add_option("--json", o.json_path, "Write every result as JSON");
+    app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
     app.add_option("--rays", o.ray_kind,
                    "frame: a frame's primary and shadow rays; ao: its primary and AO rays; diffuse: its primary "
                    "rays and one bounce per hit; random: incoherent rays")
@@ -126,9 +129,12 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     } catch (const CLI::ParseError& e) {
         return cluster::exit_parse(app, e);
     }
+    o.scenes_named = app.count("--scenes") > 0;
     cluster::together([&] {
-        for (const std::string& text : o.configs) parse_accel_config(text);
+        bench::check_configs(o.configs);
         if (!o.size.empty()) parse_image_size("--size", o.size);
+        if (o.threads > kMaxWorkers)
+            throw Error("--threads " + std::to_string(o.threads) + " must lie in [0, " + std::to_string(kMaxWorkers) + "]");
     }, "checking the options");
     return std::nullopt;
 }
@@ -400,8 +406,8 @@ nlohmann::json bench_scene(const Scene& scene, const Options& o) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-    bench::check_results_paths({o.json_path});
-    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes);
+    bench::check_results_paths({{"--json", o.json_path}}, o.overwrite);
+    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes, o.scenes_named);
     nlohmann::json out = nlohmann::json::array();
     // A scene a run: its configurations, Embree's among them, stay together on one process.
     cluster::sweep(
@@ -413,7 +419,7 @@ int run(int argc, char** argv) {
             for (const nlohmann::json& row : scene["rows"]) out.push_back(row);
         },
         "benchmarking the scenes");
-    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n");
+    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n", o.overwrite);
     return 0;
 }
 

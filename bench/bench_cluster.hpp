@@ -22,11 +22,13 @@ namespace cellrt::bench {
 
 namespace cluster = cli::cluster;
 
-// The specs (scene_file) of the scenes among `names` that the leader finds, in their order; a scene
-// the leader lacks is skipped with a message, as in one process. Every process must have the scenes
-// the leader has, at the same path, since any of them may be given a scene's runs: a process that
-// lacks one fails the step on all, named.
-inline std::vector<std::string> found_scenes(const std::string& scenes_dir, const std::vector<std::string>& names) {
+// The specs (scene_file) of the scenes among `names` that the leader finds, in their order. Where the
+// user named the scenes (`named`, --scenes given), one the leader lacks is an error; of the default
+// list, it is skipped with a message, as in one process, and finding none is an error. Every process
+// must have the scenes the leader has, at the same path, since any of them may be given a scene's
+// runs: a process that lacks one fails the step on all, named.
+inline std::vector<std::string> found_scenes(const std::string& scenes_dir, const std::vector<std::string>& names,
+                                             bool named) {
     std::vector<std::string> specs;
     std::string here;  // '1' where the scene is found on this process
     for (const std::string& name : names) {
@@ -35,10 +37,14 @@ inline std::vector<std::string> found_scenes(const std::string& scenes_dir, cons
     }
     const std::string leaders = cluster::broadcast(here);
     cluster::together([&] {
-        for (std::size_t i = 0; i < names.size(); ++i)
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            if (named && leaders[i] == '0') throw Error("--scenes " + names[i] + ": " + specs[i] + " not found");
             if (leaders[i] == '1' && here[i] == '0')
                 throw Error("scene " + names[i] + ": " + specs[i] +
                             " not found, which rank 0 has (every rank needs the scenes at the same path)");
+        }
+        if (leaders.find('1') == std::string::npos)
+            throw Error("none of the scenes is in --scenes-dir " + scenes_dir + ": name them with --scenes");
     }, "finding the scenes");
     std::vector<std::string> found;
     for (std::size_t i = 0; i < names.size(); ++i) {
@@ -48,25 +54,23 @@ inline std::vector<std::string> found_scenes(const std::string& scenes_dir, cons
     return found;
 }
 
-// Refuses, before any run, results files whose folder is not there (on the leader, which writes them):
-// a mistyped path should not cost the sweep.
-inline void check_results_paths(const std::vector<std::string>& paths) {
+// Refuses, before any run, results files (option, path; "" not asked for) that cannot be written, on
+// the leader, which writes them: a folder not there, a file the user has without `overwrite`, two
+// options naming one file. A mistyped path should not cost the sweep, nor a sweep a file.
+inline void check_results_paths(const std::vector<std::pair<std::string, std::string>>& outputs, bool overwrite) {
     cluster::together([&] {
         if (!cluster::leader()) return;
-        for (const std::string& path : paths) {
-            if (path.empty()) continue;  // not asked for
-            const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-            if (!std::filesystem::is_directory(folder))
-                throw Error(path + ": folder '" + folder.string() + "' does not exist");
-        }
+        for (const auto& [option, path] : outputs)
+            if (!path.empty()) check_output_file(path, overwrite);
+        check_distinct_files(outputs);
     }, "checking the results' paths");
 }
 
 // `text` (a JSON document, say) written whole as `path` by the leader, once every process has got
 // this far; a failure is every process's.
-inline void write_results(const std::string& path, const std::string& text) {
+inline void write_results(const std::string& path, const std::string& text, bool overwrite) {
     cluster::together([&] {
-        if (cluster::leader()) write_file_atomically(path, text, true);
+        if (cluster::leader()) write_file_atomically(path, text, overwrite);
     }, "writing " + path);
 }
 

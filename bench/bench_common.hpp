@@ -14,6 +14,7 @@
 #endif
 
 #include "cellrt/accel.hpp"
+#include "cellrt/error.hpp"
 
 namespace cellrt::bench {
 
@@ -69,6 +70,28 @@ inline std::optional<std::string> scene_spec(const std::string& scenes_dir, cons
     if (scene_found(spec)) return spec;
     print_skipped_scene(name, spec);
     return std::nullopt;
+}
+
+// Refuses, before any run, a --configs entry this binary cannot read: a malformed string, a kind
+// cellrt does not have (Embree, which a build may lack, is skipped later instead: built_in), a
+// traversal its kind does not have.
+inline void check_configs(const std::vector<std::string>& configs) {
+    const auto kinds = accelerator_kinds();
+    for (const std::string& text : configs) {
+        try {
+            const AccelConfig c = parse_accel_config(text);
+            if (c.kind == "embree" && std::find(kinds.begin(), kinds.end(), c.kind) == kinds.end()) continue;
+            const auto& traversals = accelerator_traversals(c.kind);  // refuses an unknown kind, naming the kinds
+            if (!c.traversal.empty() && std::find(traversals.begin(), traversals.end(), c.traversal) == traversals.end())
+            {
+                std::string names;
+                for (const std::string& t : traversals) names += (names.empty() ? "" : ", ") + t;
+                throw Error("unknown traversal '" + c.traversal + "' of " + c.kind + " (choose one of: " + names + ")");
+            }
+        } catch (const Error& e) {
+            throw Error("--configs '" + text + "': " + e.what());
+        }
+    }
 }
 
 // Whether this binary has the structure `kind` (Embree is optional); a missing one is skipped with a

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -22,6 +21,7 @@
 #include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
+#include "core/files.hpp"
 #include "core/timer.hpp"
 #include "cellrt/workload.hpp"
 
@@ -47,6 +47,7 @@ struct Options {
                                      "kd:branched@memory=shared,access=async"};
     std::string cpu_config = "embree";
     std::string size = "1920x1080", json_path;
+    bool overwrite = false;
     int repeats = 5, ao_samples = 4;
     unsigned threads = 0;
 };
@@ -247,21 +248,33 @@ int main(int argc, char** argv) {
     app.add_option("--repeats", o.repeats, "Timed passes (median)")->capture_default_str()->check(CLI::Range(1, 1000));
     app.add_option("--threads", o.threads, "Host threads for the yardstick (0: all)")->capture_default_str();
     app.add_option("--json", o.json_path, "Write every result as JSON");
+    app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
     CLI11_PARSE(app, argc, argv);
+    try {
+        if (!o.json_path.empty()) check_output_file(o.json_path, o.overwrite);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "cellrt_gpu_bench: error: %s\n", e.what());
+        return 1;
+    }
     const DeviceInfo gpu = cuda_device_info();
     if (!gpu.present) {
         std::printf("cuda: no device (%s)\n", gpu.reason.c_str());
         return 3;
     }
     nlohmann::json out = nlohmann::json::array();
+    bool written = false;
     try {
         for (const std::string& name : o.scenes)
             if (const auto spec = bench::scene_spec(o.scenes_dir, name)) {
                 const Scene scene = load_scene(*spec);
                 for (const std::string& kind : o.rays) {
                     bench_rays(scene, kind, o, gpu, out);
-                    // Rewritten after every set, so that a run cut short keeps what it measured.
-                    if (!o.json_path.empty()) std::ofstream(o.json_path) << out.dump(1) << "\n";
+                    // Rewritten after every set, so that a run cut short keeps what it measured: the
+                    // user's --overwrite decides the first time, the file is this run's after it.
+                    if (!o.json_path.empty()) {
+                        write_file_atomically(o.json_path, out.dump(1) + "\n", o.overwrite || written);
+                        written = true;
+                    }
                 }
             }
     } catch (const Error& e) {

@@ -82,6 +82,8 @@ struct Options {
     std::string size = "512x512";
     ShadingOptions shading;  // every frame's, the yardstick's too
     std::string csv_path, json_path;
+    bool overwrite = false;
+    bool scenes_named = false;  // --scenes given: a scene not found is an error, not skipped
     int idle_spin = static_cast<int>(kDefaultIdleSpin.count());
     bool pin = false;
 };
@@ -128,6 +130,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_flag("--pin", o.pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
     app.add_option("--csv", o.csv_path, "Write every point as CSV");
     app.add_option("--json", o.json_path, "Write every point as JSON");
+    app.add_flag("--overwrite", o.overwrite, "Replace existing --csv and --json files");
     cluster::add_bench_options(app);
     try {
         app.parse(argc, argv);
@@ -144,8 +147,12 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         // Another shading casts no AO rays: the rows would record samples that were never taken.
         if (ao_samples->count() > 0 && o.shading.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
         parse_image_size("--size", o.size);
-        for (const std::string& text : o.configs) parse_accel_config(text);
+        bench::check_configs(o.configs);
+        for (const unsigned w : o.workers)
+            if (w < 1 || w > kMaxWorkers)
+                throw Error("--workers " + std::to_string(w) + " must lie in [1, " + std::to_string(kMaxWorkers) + "]");
     }, "checking the options");
+    o.scenes_named = app.count("--scenes") > 0;
     // Every process measures the same worker counts, so that the points are those of one process.
     const unsigned cores = static_cast<unsigned>(std::stoul(cluster::broadcast(std::to_string(cluster::cores()))));
     if (o.workers.empty())
@@ -281,7 +288,7 @@ nlohmann::json measure_scene(const Scene& scene, const Options& o) {
 // Every scene found, a run of the sweep each (bench_cluster.hpp).
 Study measure(const Options& o) {
     Study study;
-    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes);
+    const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes, o.scenes_named);
     cluster::sweep(
         specs.size(), [&](std::size_t i) { return measure_scene(load_scene(specs[i]), o).dump(); },
         [&](std::size_t, const std::string& result) {
@@ -394,7 +401,7 @@ std::string csv_of(const nlohmann::json& rows) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-    bench::check_results_paths({o.json_path, o.csv_path});
+    bench::check_results_paths({{"--json", o.json_path}, {"--csv", o.csv_path}}, o.overwrite);
     const std::string yardstick = yardstick_of(o.configs);
     const Study study = measure(o);
     // One table per configuration, dispatch and packet size; then where the time of the most workers went.
@@ -406,8 +413,8 @@ int run(int argc, char** argv) {
                     print_time_shares(study, o, config, d, p);
                 }
     const nlohmann::json out = points_json(study.points, yardstick, o.shading);
-    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n");
-    if (!o.csv_path.empty()) bench::write_results(o.csv_path, csv_of(out));
+    if (!o.json_path.empty()) bench::write_results(o.json_path, out.dump(1) + "\n", o.overwrite);
+    if (!o.csv_path.empty()) bench::write_results(o.csv_path, csv_of(out), o.overwrite);
     return 0;
 }
 

@@ -231,6 +231,7 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     const std::string spheres = "builtin:spheres?tris=100";
     const std::string folder_obj = (dir.path / "folder.obj").string();
     fs::create_directory(folder_obj);
+    const std::string good_view = view("good.json", "45"), study = (dir.path / "new_study").string();
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
         {{"info", over}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
         {{"render", over, "-o", out}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
@@ -282,6 +283,13 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
         {{"render", spheres, "-o", out, "--stats", (dir.path / "no" / "s.json").string()},
          (dir.path / "no" / "s.json").string() + ": no folder " + (dir.path / "no").string() + " to write it in"},
+        // Found by review (2026-12-06): a folder as --stats failed after the image was written, and
+        // --stats naming the view file replaced it with --overwrite.
+        {{"render", spheres, "-o", out, "--stats", folder_obj}, folder_obj + ": is a folder, not a file"},
+        {{"render", good_view, "-o", out, "--stats", good_view, "--overwrite"},
+         "--stats " + good_view + " names the scene " + good_view + ", which it would replace"},
+        {{"cache-study", (dir.path / "missing.obj").string(), "--out", study},
+         (dir.path / "missing.obj").string() + ": no such file"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);
@@ -289,6 +297,10 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         EXPECT_EQ(text, "cellrt: error: " + message + "\n");
         EXPECT_FALSE(fs::exists(out));
     }
+    EXPECT_FALSE(fs::exists(study)) << "a failed cache study left its folder";
+    std::ifstream kept(good_view);
+    const std::string view_text{std::istreambuf_iterator<char>(kept), std::istreambuf_iterator<char>()};
+    EXPECT_NE(view_text.find("\"mesh\""), std::string::npos) << "the view file was replaced";
 }
 
 // An exception thrown on a render worker (here Embree refusing rays beyond its range, from a camera

@@ -108,6 +108,46 @@ TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
     std::filesystem::remove_all(dir);
 }
 
+// What an image is written to when it is not a plain new file: a pipe (as /dev/null or /dev/stdout,
+// which renaming over would have replaced by a file: found by review, 2026-12-06) is written in place
+// and stays a pipe; a link to a file keeps its link and the file is replaced; a folder is refused; a
+// name of 250 bytes, whose temporary name would pass the file system's 255, is written.
+TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
+    const Image img = render_with(make_builtin_scene("builtin:spheres?tris=400"), "brute", 2, 4, 2);
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_out_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string fifo = (dir / "pipe.pfm").string();
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    // The reader's end, open before the write (without waiting for a writer), so that the writer's
+    // open does not wait either; the image (120 bytes) fits the pipe's buffer.
+    const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+    ASSERT_GE(reader, 0);
+    write_image(img, fifo, false);
+    std::string piped(4096, '\0');
+    const ssize_t got = ::read(reader, piped.data(), piped.size());
+    ::close(reader);
+    piped.resize(got > 0 ? static_cast<std::size_t>(got) : 0);
+    struct stat st {};
+    ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+    EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe was replaced";
+    const std::string file = (dir / "file.pfm").string(), link = (dir / "link.pfm").string();
+    write_image(img, file, false);
+    std::ifstream written(file, std::ios::binary);
+    EXPECT_EQ(piped, (std::string{std::istreambuf_iterator<char>(written), std::istreambuf_iterator<char>()}));
+    std::filesystem::create_symlink("file.pfm", link);
+    EXPECT_EQ(test::error_of([&] { write_image(img, link, false); }), link + ": file exists and overwrite is off");
+    write_image(img, link, true);
+    EXPECT_TRUE(std::filesystem::is_symlink(link));
+    EXPECT_TRUE(same_bits(read_pfm(file), img));
+    const std::string folder = (dir / "folder.pfm").string();
+    std::filesystem::create_directories(folder);
+    EXPECT_EQ(test::error_of([&] { write_image(img, folder, true); }), folder + ": is a folder, not a file");
+    const std::string long_name = (dir / (std::string(246, 'a') + ".pfm")).string();
+    write_image(img, long_name, false);
+    EXPECT_TRUE(same_bits(read_pfm(long_name), img));
+    std::filesystem::remove_all(dir);
+}
+
 // read_pfm reads only a regular file, as the loaders do: a folder or a named pipe in the image's place
 // is refused with its name, not opened and waited on.
 TEST(Render, ReadPfmRefusesWhatIsNotARegularFile) {

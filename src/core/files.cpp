@@ -1,7 +1,10 @@
 #include "core/files.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -10,6 +13,42 @@
 
 namespace cellrt {
 
+namespace {
+
+namespace fs = std::filesystem;
+
+// What `path` names once links are followed: a regular file, a folder, something else (a device, a
+// pipe, a socket), or nothing.
+enum class Target { none, file, folder, other };
+
+Target target_of(const std::string& path) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) return Target::none;
+    if (fs::is_directory(st)) return Target::folder;
+    return fs::is_regular_file(st) ? Target::file : Target::other;
+}
+
+// The file an existing path names, links followed, so that its folder takes the temporary file and
+// the rename replaces the file, not the link.
+fs::path resolved(const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::canonical(path, ec);
+    return ec ? fs::path(path) : p;
+}
+
+fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
+
+void write_in_place(const std::string& path, std::string_view bytes) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw Error(path + ": cannot be opened for writing");
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw Error(path + ": write failed");
+}
+
+}  // namespace
+
 std::string lower_extension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -17,15 +56,20 @@ std::string lower_extension(const std::string& path) {
 }
 
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite) {
-    namespace fs = std::filesystem;
+    const Target kind = target_of(path);
+    if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
+    if (kind == Target::other) return write_in_place(path, bytes);
+    if (kind == Target::file && !overwrite) throw Error(path + ": file exists and overwrite is off");
+    const fs::path target = kind == Target::file ? resolved(path) : fs::path(path);
+    const fs::path dir = folder_of(target);
     std::error_code ec;
-    if (!overwrite && fs::exists(path, ec)) throw Error(path + ": file exists and overwrite is off");
-    const fs::path target(path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");
+    // Hidden, beside the target, named after it as far as a name's 255 bytes allow, and unique to
+    // this process and call.
+    static std::atomic<unsigned> calls{0};
     std::string temp_name = ".";  // appended piece by piece: GCC 12 warns wrongly on "." + string (PR 105651)
-    temp_name += target.filename().string();
-    temp_name += ".part" + std::to_string(::getpid());
+    temp_name += target.filename().string().substr(0, 200);
+    temp_name += ".part" + std::to_string(::getpid()) + "-" + std::to_string(calls++);
     const fs::path temp = dir / temp_name;
     {
         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
@@ -41,6 +85,60 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     if (ec) {
         fs::remove(temp, ec);
         throw Error(path + ": cannot move the finished file into place");
+    }
+}
+
+void check_output_file(const std::string& path, bool overwrite) {
+    if (path.empty()) throw Error("an output file's name is empty");
+    const Target kind = target_of(path);
+    if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
+    const auto refused = [&](const std::string& what) {
+        throw Error(path + ": " + what + " (" + std::strerror(errno) + ")");
+    };
+    if (kind == Target::other) {
+        if (::access(path.c_str(), W_OK) != 0) refused("cannot be written");
+        return;
+    }
+    if (kind == Target::file && !overwrite) throw Error(path + ": file exists (pass --overwrite to replace it)");
+    const fs::path dir = folder_of(kind == Target::file ? resolved(path) : fs::path(path));
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw Error(path + ": no folder " + dir.string() + " to write it in");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0) refused("cannot write in the folder '" + dir.string() + "'");
+}
+
+void check_output_folder(const std::string& option, const std::string& path) {
+    const std::string named = option + " '" + path + "'";
+    if (path.empty()) throw Error(option + ": the folder's name is empty");
+    std::error_code ec;
+    fs::path at = fs::absolute(path, ec);
+    if (ec) throw Error(named + ": " + ec.message());
+    // The nearest part of the path that exists must be a folder this process may write in.
+    while (!fs::exists(at, ec) && at.has_parent_path() && at.parent_path() != at) at = at.parent_path();
+    if (!fs::is_directory(at, ec))
+        throw Error(named + ": " + at.string() + " is a file, not a folder");
+    if (::access(at.c_str(), W_OK | X_OK) != 0)
+        throw Error(named + ": cannot write in " + at.string() + " (" + std::strerror(errno) + ")");
+}
+
+// A path as the file it names: links and dots resolved where the system can, else as written.
+static fs::path file_named(const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(path, ec);
+    return ec ? fs::absolute(path, ec).lexically_normal() : p;
+}
+
+void check_distinct_files(const std::vector<std::pair<std::string, std::string>>& outputs,
+                          const std::vector<std::pair<std::string, std::string>>& inputs) {
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        const auto& [option, path] = outputs[i];
+        if (path.empty()) continue;
+        for (std::size_t j = 0; j < i; ++j)
+            if (!outputs[j].second.empty() && file_named(outputs[j].second) == file_named(path))
+                throw Error(option + " " + path + " names the same file as " + outputs[j].first + " " +
+                            outputs[j].second);
+        for (const auto& [what, input] : inputs)
+            if (!input.empty() && target_of(input) == Target::file && file_named(input) == file_named(path))
+                throw Error(option + " " + path + " names the " + what + " " + input + ", which it would replace");
     }
 }
 

@@ -1,0 +1,47 @@
+# The benchmark programs' bad inputs and outputs: each refused before any run with one line naming the
+# option, status 1, and no file the user has replaced. Arguments: BENCH (cellrt_bench), SCALING
+# (cellrt_scaling), WORK (a scratch folder).
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+set(mine "the user's own file\n")
+file(WRITE ${WORK}/mine.json "${mine}")
+file(MAKE_DIRECTORY ${WORK}/folder.json)
+set(small --scenes builtin:city?tris=300 --size 8x8 --repeats 1)
+
+# expect(MESSAGE PROGRAM ARGS...): the program fails with status 1 and prints exactly MESSAGE.
+function(expect message program)
+  execute_process(COMMAND ${program} ${ARGN} OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
+  get_filename_component(name ${program} NAME)
+  if(NOT rc EQUAL 1 OR NOT err STREQUAL "${name}: error: ${message}\n")
+    message(FATAL_ERROR "${name} ${ARGN}: status ${rc}, printed '${err}', expected '${name}: error: ${message}'")
+  endif()
+endfunction()
+
+expect("--configs 'bogus': unknown accelerator 'bogus' (choose one of: brute, kd, bih, bvh, auto, embree)"
+       ${BENCH} ${small} --configs bogus)
+expect("--configs 'kd:nope': unknown traversal 'nope' of kd (choose one of: branched, rec, branchless)"
+       ${BENCH} ${small} --configs kd:nope)
+expect("--scenes nosuch: ${WORK}/nosuch/nosuch.json not found"
+       ${BENCH} --scenes-dir ${WORK} --scenes nosuch --configs kd --size 8x8 --repeats 1)
+expect("--threads 100000 must lie in [0, 1024]" ${BENCH} ${small} --configs kd --threads 100000)
+expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
+       ${BENCH} ${small} --configs kd --json ${WORK}/mine.json)
+expect("${WORK}/folder.json: is a folder, not a file" ${BENCH} ${small} --configs kd --json ${WORK}/folder.json)
+expect("--workers 0 must lie in [1, 1024]" ${SCALING} ${small} --configs kd --workers 0)
+expect("--csv ${WORK}/x.json names the same file as --json ${WORK}/x.json"
+       ${SCALING} ${small} --configs kd --workers 1 --json ${WORK}/x.json --csv ${WORK}/x.json)
+expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
+       ${SCALING} ${small} --configs kd --workers 1 --csv ${WORK}/mine.json)
+file(READ ${WORK}/mine.json kept)
+if(NOT kept STREQUAL "${mine}" OR EXISTS ${WORK}/x.json)
+  message(FATAL_ERROR "a refused run wrote a file: mine.json now '${kept}'")
+endif()
+
+# With --overwrite the file is replaced by the results.
+execute_process(COMMAND ${BENCH} ${small} --configs kd --builds 1 --json ${WORK}/mine.json --overwrite
+                OUTPUT_QUIET ERROR_QUIET RESULT_VARIABLE rc)
+file(READ ${WORK}/mine.json replaced)
+string(JSON rows LENGTH "${replaced}")
+if(NOT rc EQUAL 0 OR NOT rows EQUAL 1)
+  message(FATAL_ERROR "--overwrite: status ${rc}, ${rows} rows in '${replaced}'")
+endif()
