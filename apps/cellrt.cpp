@@ -19,6 +19,7 @@ int run(int argc, char** argv) {
     // The first command is the default: `cellrt` alone renders the default scene.
     const std::vector<cli::Runner> runners = {cli::add_render(app), cli::add_info(app), cli::add_profile(app),
                                               cli::add_cache_study(app)};
+    cli::cluster::strict_numbers(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -61,5 +62,5 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "cellrt: error: %s\n", e.what());
         return 1;
     }
-    return cellrt::cli::cluster::finish(run(argc, argv));
+    return cellrt::cli::cluster::finish(cellrt::cli::cluster::flushed(run(argc, argv)));
 }

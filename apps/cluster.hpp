@@ -8,8 +8,12 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json_fwd.hpp>
 
+#include <charconv>
 #include <cstddef>
+#include <cstdio>
 #include <exception>
+#include <string_view>
+#include <system_error>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -36,13 +40,65 @@ inline bool leader() { return rank() == 0; }  // prints, and writes the outputs
 // Prints the error a command ended with, as "PROGRAM: error: ..." (under MPI once, by rank 0, for an
 // error all ranks agreed on, and with the rank's number otherwise).
 void print_error(const std::exception& e);
+// The program's name, as start() was given it.
+const char* program();
 
 // CLI11's exit for a command line it refused, or for --help: every process parsed the same line, so
-// the leader speaks for all.
+// the leader speaks for all. --help and its kind print what they ask for, status 0; a refused line is
+// bad input like any other, one line "PROGRAM: error: ..." naming the option and status 1 (CLI11's
+// own form was two lines and a status of 101 to 114).
 inline int exit_parse(const CLI::App& app, const CLI::ParseError& e) {
-    if (leader()) return app.exit(e);
-    std::ostringstream silent;
-    return app.exit(e, silent, silent);
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
+        if (leader()) return app.exit(e);
+        std::ostringstream silent;
+        return app.exit(e, silent, silent);
+    }
+    if (leader()) std::fprintf(stderr, "%s: error: %s (see --help)\n", program(), e.what());
+    return 1;
+}
+
+// The exit status once what the program printed has reached standard output: a report printed into
+// a full disk or a closed pipe (`cellrt info scene.json > /dev/full`) is lost, and a status of 0
+// would say it was not. Call it with the status the command ended with, before finish().
+inline int flushed(int status) {
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return status;
+    if (leader()) std::fprintf(stderr, "%s: error: standard output: write failed\n", program());
+    return status == 0 ? 1 : status;
+}
+
+// Integer options read as decimal digits only (no sign, no leading zero), and numbers as
+// std::from_chars reads them: CLI11 (2.1)
+// reads integers by strtoll's rules, so that `--threads 010` meant 8, `0x10` 16 and " 4" 4, and `""`
+// 0, where the values in files and -P are decimal. Added to every option of `app` and its
+// subcommands whose type is INT, UINT or FLOAT (call it after the options are made).
+inline void strict_numbers(CLI::App& app) {
+    const auto kind = [](const CLI::Option* o) {
+        const std::string t = o->get_type_name();
+        return t.substr(0, t.find(':'));
+    };
+    const CLI::Validator integer(
+        [](std::string& value) -> std::string {
+            // No leading zero either, which CLI11's conversion would read as octal.
+            const bool digits = !value.empty() && value.find_first_not_of("0123456789") == std::string::npos &&
+                                (value == "0" || value[0] != '0');
+            return digits ? std::string() : "'" + value + "' is not a whole number in decimal digits";
+        },
+        "", "decimal");
+    const CLI::Validator number(
+        [](std::string& value) -> std::string {
+            const std::string_view v = !value.empty() && value[0] == '+' ? std::string_view(value).substr(1) : value;
+            double d = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
+            const bool whole = !v.empty() && end == v.data() + v.size() && ec == std::errc();
+            return whole ? std::string() : "'" + value + "' is not a decimal number";
+        },
+        "", "decimal number");
+    for (CLI::Option* o : app.get_options()) {
+        const std::string k = kind(o);
+        if (k == "INT" || k == "UINT") o->check(integer);
+        else if (k == "FLOAT") o->check(number);
+    }
+    for (CLI::App* sub : app.get_subcommands({})) strict_numbers(*sub);
 }
 
 // The options a distributed command adds (none in the plain program): a frame's, a sweep's (the

@@ -124,6 +124,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         ->capture_default_str()
         ->check(CLI::IsMember({"wall", "cpu"}));
     cluster::add_bench_options(app);
+    cluster::strict_numbers(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -92,7 +92,7 @@ inline int main_on_cluster(int argc, char** argv, const char* program, const std
     } catch (const std::exception& e) {
         cluster::print_error(e);
     }
-    return cluster::finish(status);
+    return cluster::finish(cluster::flushed(status));
 }
 
 }  // namespace cellrt::bench

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
+#include "cluster.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
@@ -249,7 +250,13 @@ int main(int argc, char** argv) {
     app.add_option("--threads", o.threads, "Host threads for the yardstick (0: all)")->capture_default_str();
     app.add_option("--json", o.json_path, "Write every result as JSON");
     app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
-    CLI11_PARSE(app, argc, argv);
+    cli::cluster::start(argc, argv, "cellrt_gpu_bench");
+    cli::cluster::strict_numbers(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return cli::cluster::exit_parse(app, e);
+    }
     try {
         if (!o.json_path.empty()) check_output_file(o.json_path, o.overwrite);
     } catch (const Error& e) {

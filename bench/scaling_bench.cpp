@@ -132,6 +132,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--json", o.json_path, "Write every point as JSON");
     app.add_flag("--overwrite", o.overwrite, "Replace existing --csv and --json files");
     cluster::add_bench_options(app);
+    cluster::strict_numbers(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -24,6 +24,8 @@ expect("--configs 'kd:nope': unknown traversal 'nope' of kd (choose one of: bran
 expect("--scenes nosuch: ${WORK}/nosuch/nosuch.json not found"
        ${BENCH} --scenes-dir ${WORK} --scenes nosuch --configs kd --size 8x8 --repeats 1)
 expect("--threads 100000 must lie in [0, 1024]" ${BENCH} ${small} --configs kd --threads 100000)
+expect("--builds: '010' is not a whole number in decimal digits (see --help)" ${BENCH} ${small} --configs kd --builds 010)
+expect("The following argument was not expected: --bogus (see --help)" ${SCALING} ${small} --configs kd --bogus)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${BENCH} ${small} --configs kd --json ${WORK}/mine.json)
 expect("${WORK}/folder.json: is a folder, not a file" ${BENCH} ${small} --configs kd --json ${WORK}/folder.json)

@@ -290,6 +290,19 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
          "--stats " + good_view + " names the scene " + good_view + ", which it would replace"},
         {{"cache-study", (dir.path / "missing.obj").string(), "--out", study},
          (dir.path / "missing.obj").string() + ": no such file"},
+        // Integers in decimal digits only: CLI11 read `010` as 8, `0x2` as 2, " 4" as 4 and "" as 0
+        // (all cores); and CLI11's own refusals in this program's one-line form, status 1, where they
+        // were two lines and a status of 101 to 114 (found by review, 2026-12-06).
+        {{"render", spheres, "--packet", "010", "-o", out},
+         "--packet: '010' is not a whole number in decimal digits (see --help)"},
+        {{"render", spheres, "--threads", "0x2", "-o", out},
+         "--threads: '0x2' is not a whole number in decimal digits (see --help)"},
+        {{"render", spheres, "--packet", " 4", "-o", out}, "--packet: ' 4' is not a whole number in decimal digits (see --help)"},
+        {{"render", spheres, "--threads", "", "-o", out}, "--threads: '' is not a whole number in decimal digits (see --help)"},
+        {{"render", spheres, "--threads", "-1", "-o", out},
+         "--threads: '-1' is not a whole number in decimal digits (see --help)"},
+        {{"render", spheres, "--bogus", "-o", out}, "The following argument was not expected: --bogus (see --help)"},
+        {{"render", spheres, "-o", out, "-o", out}, "--output: At Most 1 required but received 2 (see --help)"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);
@@ -328,6 +341,23 @@ TEST(Cli, AnErrorOnARenderWorkerIsTheProgramsError) {
 
 // A scene named after a file whose name is not UTF-8 still gets its JSON report (nlohmann::json
 // would throw on the bytes once the render is done); they become U+FFFD.
+// A report printed into a full disk is lost: `cellrt info` into /dev/full ended with status 0 (found by
+// review, 2026-12-06); now it says so and ends with 1.
+TEST(Cli, OutputThatCannotBeWrittenIsAnError) {
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
+    TempDir dir;
+    const std::string errors = (dir.path / "errors.txt").string();
+    for (const std::string args : {"info builtin:city?tris=300", "info --params kd"}) {
+        const int status = std::system((std::string(CELLRT_CLI) + " " + args + " > /dev/full 2> " + errors).c_str());
+        ASSERT_TRUE(WIFEXITED(status)) << args;
+        EXPECT_EQ(WEXITSTATUS(status), 1) << args;
+        std::ifstream in(errors);
+        EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()),
+                  "cellrt: error: standard output: write failed\n")
+            << args;
+    }
+}
+
 TEST(Cli, StatsOfAFileNamedInAnyBytes) {
     TempDir dir;
     const std::string mesh = (dir.path / "\xff\xfe.obj").string(), stats = (dir.path / "stats.json").string();

@@ -71,6 +71,8 @@ int rank() { return session().rank(); }
 int ranks() { return session().size(); }
 unsigned cores() { return distributed::rank_threads(0); }
 
+const char* program() { return session().program().c_str(); }
+
 void print_error(const std::exception& e) {
     if (dynamic_cast<const distributed::AgreedError*>(&e)) {
         if (leader()) std::fprintf(stderr, "%s: error: %s\n", session().program().c_str(), e.what());
