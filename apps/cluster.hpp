@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
@@ -55,6 +56,19 @@ inline int exit_parse(const CLI::App& app, const CLI::ParseError& e) {
     }
     if (leader()) std::fprintf(stderr, "%s: error: %s (see --help)\n", program(), e.what());
     return 1;
+}
+
+// Refuses a list option that names one value twice (`--structures kd kd`, `--packets 8 8`): its runs
+// would be made and written twice.
+template <class T>
+void check_no_repeats(const std::string& option, const std::vector<T>& values) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (values[i] == values[j]) {
+                std::ostringstream named;
+                named << values[i];
+                throw Error(option + " names '" + named.str() + "' twice");
+            }
 }
 
 // The exit status once what the program printed has reached standard output: a report printed into

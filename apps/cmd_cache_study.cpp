@@ -300,6 +300,7 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
 std::vector<std::string> checked_choices(const std::string& option, const std::vector<std::string>& values,
                                          const std::vector<std::string>& allowed) {
     if (values.empty()) throw Error(option + " needs at least one value");
+    cluster::check_no_repeats(option, values);
     for (const std::string& v : values)
         if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
             std::string list;

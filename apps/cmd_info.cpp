@@ -65,6 +65,10 @@ Runner add_info(CLI::App& app) {
     o->accel.add_to(*cmd, true, true);
     return [o] {
         if (!o->params.empty()) {
+            // It prints a table and stops: a scene or a structure beside it would be ignored.
+            if (!o->scene.empty() || !o->accel.kind.empty() || o->accel.describes_structure() ||
+                o->accel.device != "cpu")
+                throw Error("info: --params KIND prints that structure's parameters and nothing else: give it alone");
             print_params(o->params);
             return 0;
         }

@@ -133,6 +133,8 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     o.scenes_named = app.count("--scenes") > 0;
     cluster::together([&] {
         bench::check_configs(o.configs);
+        cluster::check_no_repeats("--configs", o.configs);
+        cluster::check_no_repeats("--scenes", o.scenes);
         if (!o.size.empty()) parse_image_size("--size", o.size);
         if (o.threads > kMaxWorkers)
             throw Error("--threads " + std::to_string(o.threads) + " must lie in [0, " + std::to_string(kMaxWorkers) + "]");

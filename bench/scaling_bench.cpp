@@ -149,6 +149,10 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         if (ao_samples->count() > 0 && o.shading.shading != Shading::ao) throw Error("--ao-samples needs --shading ao");
         parse_image_size("--size", o.size);
         bench::check_configs(o.configs);
+        cluster::check_no_repeats("--configs", o.configs);
+        cluster::check_no_repeats("--scenes", o.scenes);
+        cluster::check_no_repeats("--dispatch", o.dispatches);
+        cluster::check_no_repeats("--packets", o.packets);
         for (const unsigned w : o.workers)
             if (w < 1 || w > kMaxWorkers)
                 throw Error("--workers " + std::to_string(w) + " must lie in [1, " + std::to_string(kMaxWorkers) + "]");

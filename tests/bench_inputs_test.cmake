@@ -26,6 +26,8 @@ expect("--scenes nosuch: ${WORK}/nosuch/nosuch.json not found"
 expect("--threads 100000 must lie in [0, 1024]" ${BENCH} ${small} --configs kd --threads 100000)
 expect("--builds: '010' is not a whole number in decimal digits (see --help)" ${BENCH} ${small} --configs kd --builds 010)
 expect("The following argument was not expected: --bogus (see --help)" ${SCALING} ${small} --configs kd --bogus)
+expect("--configs names 'kd' twice" ${BENCH} ${small} --configs kd kd)
+expect("--packets names '8' twice" ${SCALING} ${small} --configs kd --packets 8 8)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${BENCH} ${small} --configs kd --json ${WORK}/mine.json)
 expect("${WORK}/folder.json: is a folder, not a file" ${BENCH} ${small} --configs kd --json ${WORK}/folder.json)

@@ -303,6 +303,12 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
          "--threads: '-1' is not a whole number in decimal digits (see --help)"},
         {{"render", spheres, "--bogus", "-o", out}, "The following argument was not expected: --bogus (see --help)"},
         {{"render", spheres, "-o", out, "-o", out}, "--output: At Most 1 required but received 2 (see --help)"},
+        {{"render", "", "-o", out}, "the scene's name is empty"},
+        {{"render", spheres, "-o", (dir.path / ".pfm").string()},
+         (dir.path / ".pfm").string() + ": no extension to choose the image format by (use .png or .pfm)"},
+        {{"info", spheres, "--params", "kd"},
+         "info: --params KIND prints that structure's parameters and nothing else: give it alone"},
+        {{"cache-study", spheres, "--structures", "kd", "kd", "--out", study}, "--structures names 'kd' twice"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);

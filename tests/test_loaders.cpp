@@ -594,6 +594,33 @@ json view_doc() {
             {"image", {{"width", 64}, {"height", 32}}}};
 }
 
+// Found by review (2026-12-06): a key given twice was read as its last value without a word, a mesh
+// path with a NUL loaded the file named before it, and a mesh path naming a folder was "an unknown
+// mesh format ''".
+TEST_F(LoaderTest, ViewFileKeysGivenTwiceAndOddMeshPathsAreNamed) {
+    write("tri.obj", kTriangleObj);
+    std::filesystem::create_directory(dir_ / "meshes");
+    const std::string doc = view_doc().dump();  // keys sorted: camera, image, light, mesh, name
+    const auto edited = [&](const std::string& from, const std::string& to) {
+        std::string text = doc;
+        const std::size_t at = text.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return text.replace(at, from.size(), to);
+    };
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {edited("\"name\":", "\"image\":{\"width\":8,\"height\":8},\"name\":"), "field 'image' is given twice"},
+        {edited("\"look_at\":", "\"position\":[0,0,1],\"look_at\":"), "field 'camera.position' is given twice"},
+        {edited("\"tri.obj\"", "\"tri.obj\\u0000/other.obj\""), "field 'mesh' must not contain a NUL character"},
+        {edited("\"tri.obj\"", "\"meshes\""),
+         "field 'mesh' names " + (dir_ / "meshes").string() + ", which is a folder, not a file"},
+    };
+    for (const auto& [text, message] : cases) {
+        const std::string path = write("view.json", text);
+        EXPECT_EQ(error_of([&] { load_scene(path); }), path + ": " + message) << text;
+    }
+    EXPECT_EQ(error_of([] { load_scene(""); }), "the scene's name is empty");
+}
+
 TEST_F(LoaderTest, ViewFileGivesMeshCameraLightAndSize) {
     write("tri.obj", kTriangleObj);
     const Scene s = load_scene(write("view.json", view_doc().dump()));

@@ -123,6 +123,7 @@ void write_image(const Image& image, const std::string& path, bool overwrite) {
     std::string bytes;
     if (ext == ".png") bytes = encode_png(to_srgb8(image));
     else if (ext == ".pfm") bytes = encode_pfm(image);
+    else if (ext.empty()) throw Error(path + ": no extension to choose the image format by (use .png or .pfm)");
     else throw Error(path + ": unknown image format '" + ext + "' (use .png or .pfm)");
 
     write_file_atomically(path, bytes, overwrite);

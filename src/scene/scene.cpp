@@ -76,6 +76,7 @@ std::vector<Triangle> load_mesh(const std::string& path) {
 }
 
 Scene load_scene(const std::string& spec) {
+    if (spec.empty()) throw Error("the scene's name is empty");
     if (spec.rfind("builtin:", 0) == 0) return make_builtin_scene(spec);
     if (!detail::file_exists(spec)) throw Error(spec + ": no such file");
     // Before the extension decides the format: a folder named without one ("." or "/tmp") would be

@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <string_view>
+#include <system_error>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -112,9 +114,29 @@ public:
 
     Scene read() const {
         const std::string text = detail::read_file(path_);
+        // nlohmann::json keeps the last of two equal keys: a view that gave "image" twice was read
+        // with the second without a word. The parser's callback sees each object's keys in turn.
+        struct Object {
+            std::string name;
+            std::vector<std::string> keys;
+        };
+        std::vector<Object> objects;
+        std::string key_name;  // the field the next object or value is, as "camera.position"
+        const json::parser_callback_t once = [&](int, json::parse_event_t event, json& parsed) {
+            if (event == json::parse_event_t::object_start) objects.push_back({key_name, {}});
+            if (event == json::parse_event_t::object_end && !objects.empty()) objects.pop_back();
+            if (event == json::parse_event_t::key && !objects.empty()) {
+                Object& o = objects.back();
+                const std::string k = parsed.get<std::string>();
+                key_name = o.name.empty() ? k : o.name + "." + k;
+                if (std::find(o.keys.begin(), o.keys.end(), k) != o.keys.end()) fail(key_name, "is given twice");
+                o.keys.push_back(k);
+            }
+            return true;
+        };
         json doc;
         try {
-            doc = json::parse(text, nullptr, true, /*ignore_comments=*/true);
+            doc = json::parse(text, once, true, /*ignore_comments=*/true);
         } catch (const json::exception& e) {
             const std::size_t at = ErrorPosition::in(text);
             const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
@@ -125,10 +147,14 @@ public:
 
         const json& mesh = field(doc, "", "mesh");
         if (!mesh.is_string() || mesh.get<std::string>().empty()) fail("mesh", "must be a non-empty string");
+        // A path ends at a NUL for the system: "m.obj\u0000/x.obj" loaded m.obj without a word.
+        if (mesh.get<std::string>().find('\0') != std::string::npos) fail("mesh", "must not contain a NUL character");
         const std::filesystem::path mesh_path =
             std::filesystem::path(path_).parent_path() / mesh.get<std::string>();
         if (!detail::file_exists(mesh_path.string()))
             fail("mesh", "names " + mesh_path.string() + ", which does not exist");
+        if (std::error_code ec; std::filesystem::is_directory(mesh_path, ec))
+            fail("mesh", "names " + mesh_path.string() + ", which is a folder, not a file");
 
         Scene scene;
         scene.name = doc.contains("name") && doc["name"].is_string()
