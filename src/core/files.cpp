@@ -37,6 +37,13 @@ fs::path resolved(const std::string& path) {
     return ec ? fs::path(path) : p;
 }
 
+// A path as the file it names: links and dots resolved where the system can, else as written.
+fs::path file_named(const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(path, ec);
+    return ec ? fs::absolute(path, ec).lexically_normal() : p;
+}
+
 fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
 
 void write_in_place(const std::string& path, std::string_view bytes) {
@@ -92,18 +99,21 @@ void check_output_file(const std::string& path, bool overwrite) {
     if (path.empty()) throw Error("an output file's name is empty");
     const Target kind = target_of(path);
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
-    const auto refused = [&](const std::string& what) {
-        throw Error(path + ": " + what + " (" + std::strerror(errno) + ")");
-    };
-    if (kind == Target::other) {
-        if (::access(path.c_str(), W_OK) != 0) refused("cannot be written");
+    if (kind == Target::other) {  // written in place
+        if (::access(path.c_str(), W_OK) != 0) {
+            const int error = errno;
+            throw Error(path + ": cannot be written (" + std::strerror(error) + ")");
+        }
         return;
     }
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists (pass --overwrite to replace it)");
     const fs::path dir = folder_of(kind == Target::file ? resolved(path) : fs::path(path));
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": no folder " + dir.string() + " to write it in");
-    if (::access(dir.c_str(), W_OK | X_OK) != 0) refused("cannot write in the folder '" + dir.string() + "'");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0) {  // the temporary file is made there
+        const int error = errno;
+        throw Error(path + ": cannot write in the folder '" + dir.string() + "' (" + std::strerror(error) + ")");
+    }
 }
 
 void check_output_folder(const std::string& option, const std::string& path) {
@@ -116,15 +126,10 @@ void check_output_folder(const std::string& option, const std::string& path) {
     while (!fs::exists(at, ec) && at.has_parent_path() && at.parent_path() != at) at = at.parent_path();
     if (!fs::is_directory(at, ec))
         throw Error(named + ": " + at.string() + " is a file, not a folder");
-    if (::access(at.c_str(), W_OK | X_OK) != 0)
-        throw Error(named + ": cannot write in " + at.string() + " (" + std::strerror(errno) + ")");
-}
-
-// A path as the file it names: links and dots resolved where the system can, else as written.
-static fs::path file_named(const std::string& path) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(path, ec);
-    return ec ? fs::absolute(path, ec).lexically_normal() : p;
+    if (::access(at.c_str(), W_OK | X_OK) != 0) {
+        const int error = errno;
+        throw Error(named + ": cannot write in " + at.string() + " (" + std::strerror(error) + ")");
+    }
 }
 
 void check_distinct_files(const std::vector<std::pair<std::string, std::string>>& outputs,
