@@ -9,6 +9,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <exception>
@@ -81,7 +82,7 @@ inline int flushed(int status) {
 }
 
 // Integer options read as decimal digits only (no sign, no leading zero), and numbers as
-// std::from_chars reads them: CLI11 (2.1)
+// std::from_chars reads them, finite: CLI11 (2.1)
 // reads integers by strtoll's rules, so that `--threads 010` meant 8, `0x10` 16 and " 4" 4, and `""`
 // 0, where the values in files and -P are decimal. Added to every option of `app` and its
 // subcommands whose type is INT, UINT or FLOAT (call it after the options are made).
@@ -103,8 +104,9 @@ inline void strict_numbers(CLI::App& app) {
             const std::string_view v = !value.empty() && value[0] == '+' ? std::string_view(value).substr(1) : value;
             double d = 0;
             const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
-            const bool whole = !v.empty() && end == v.data() + v.size() && ec == std::errc();
-            return whole ? std::string() : "'" + value + "' is not a decimal number";
+            // Finite too: a NaN passes CLI11's range checks, whose comparisons are false.
+            const bool whole = !v.empty() && end == v.data() + v.size() && ec == std::errc() && std::isfinite(d);
+            return whole ? std::string() : "'" + value + "' is not a finite decimal number";
         },
         "", "decimal number");
     for (CLI::Option* o : app.get_options()) {

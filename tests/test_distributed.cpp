@@ -344,10 +344,10 @@ TEST_F(Distributed, ABadOptionIsOneMessage) {
     expect_failure(shell(mpirun(3) + mpi + " render " + kScene + " --packet 0 -o " + out.string(), dir.path), out,
                    "rank 0: ", "--packet 0 must lie in [1, 256]");
     expect_failure(shell(mpirun(2) + mpi + " info " + kScene, dir.path), out, "rank 0: ", "info runs in one process");
-    // CLI11's own check, on every rank: not a time-out of NaN seconds.
+    // The command line's own check, on every rank: not a time-out of NaN seconds.
     const Outcome nan = shell(mpirun(2) + mpi + " render " + kScene + " --rank-timeout nan -o " + out.string(), dir.path);
     EXPECT_NE(nan.status, 0);
-    EXPECT_NE(nan.err.find("--rank-timeout: nan is not a number of seconds"), std::string::npos) << nan.err;
+    EXPECT_NE(nan.err.find("--rank-timeout: 'nan' is not a finite decimal number"), std::string::npos) << nan.err;
     EXPECT_FALSE(fs::exists(out));
 }
 
