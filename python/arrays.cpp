@@ -202,15 +202,23 @@ Vec3 vec3_value(py::handle object, const std::string& name) {
     return Vec3{p[0], p[1], p[2]};
 }
 
-unsigned small_count(py::handle object, const std::string& name, unsigned max) {
-    const std::string range = " must be an integer in [0, " + std::to_string(max) + "]";
-    if (py::isinstance<py::bool_>(object) || PyIndex_Check(object.ptr()) == 0)
+bool is_numpy_kind(py::handle object, char kind) {
+    if (py::isinstance<py::array>(object) || !py::hasattr(object, "dtype")) return false;
+    const py::object dtype = object.attr("dtype");
+    return py::hasattr(dtype, "kind") && py::str(dtype.attr("kind")).cast<std::string>() == std::string(1, kind);
+}
+
+bool is_bool(py::handle object) { return py::isinstance<py::bool_>(object) || is_numpy_kind(object, 'b'); }
+
+unsigned small_count(py::handle object, const std::string& name, unsigned max, unsigned min) {
+    const std::string range = " must be an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+    if (is_bool(object) || PyIndex_Check(object.ptr()) == 0)
         throw py::value_error(name + range + ", got " + py::repr(object).cast<std::string>());
     const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(object.ptr()));
     if (!index) throw py::error_already_set();
     int overflow = 0;
     const long long value = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-    if (overflow != 0 || value < 0 || value > static_cast<long long>(max))
+    if (overflow != 0 || value < static_cast<long long>(min) || value > static_cast<long long>(max))
         throw py::value_error(name + range + ", got " + py::repr(index).cast<std::string>());
     return static_cast<unsigned>(value);
 }
@@ -218,7 +226,12 @@ unsigned small_count(py::handle object, const std::string& name, unsigned max) {
 std::string text(py::handle object, const std::string& name) {
     if (!py::isinstance<py::str>(object))
         throw py::value_error(name + " must be a str, got " + py::repr(object).cast<std::string>());
-    std::string s = object.cast<std::string>();
+    std::string s;
+    try {
+        s = object.cast<std::string>();
+    } catch (const py::cast_error&) {  // a lone surrogate, which UTF-8 cannot encode
+        throw py::value_error(name + " must be text that UTF-8 can encode, got " + py::repr(object).cast<std::string>());
+    }
     // The library's messages are C strings: a NUL would cut the name it is refused with.
     if (s.find('\0') != std::string::npos)
         throw py::value_error(name + " must not contain a NUL character, got " + py::repr(object).cast<std::string>());

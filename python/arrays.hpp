@@ -52,8 +52,15 @@ std::vector<Triangle> triangle_soup(py::handle triangles);
 // A point or vector: three finite numbers.
 Vec3 vec3_value(py::handle object, const std::string& name);
 
-// A non-negative integer no larger than `max`, refused as ValueError naming `name` otherwise.
-unsigned small_count(py::handle object, const std::string& name, unsigned max);
+// Whether `object` is a numpy scalar (not an array) whose dtype is of `kind`: 'b' bool, 'i' and 'u'
+// integers, 'f' floats.
+bool is_numpy_kind(py::handle object, char kind);
+// A Python bool or a numpy one (np.bool_ is no subclass of bool, and numpy lets it serve as an index).
+bool is_bool(py::handle object);
+
+// An integer in [min, max], refused as ValueError naming `name` otherwise; a bool,
+// Python's or numpy's, is refused too.
+unsigned small_count(py::handle object, const std::string& name, unsigned max, unsigned min = 0);
 
 // A str argument; ValueError naming `name` for anything else.
 std::string text(py::handle object, const std::string& name);

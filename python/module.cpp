@@ -102,11 +102,14 @@ void refuse_second_init(py::class_<T, Options...>& cls) {
         py::name("init_once"), py::is_method(cls), py::doc(doc.c_str()));
 }
 
+// numpy's scalars count as what they hold: np.int64(2) as 2, np.bool_(True) as true, np.float32(0.5)
+// as 0.5 (np.int64 was refused, np.float64, a float subclass, taken).
 std::string param_value(py::handle value, const std::string& name) {
     if (py::isinstance<py::str>(value)) return text(value, name);
-    if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
-    if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
-    if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+    if (is_bool(value)) return PyObject_IsTrue(value.ptr()) ? "true" : "false";
+    if (PyIndex_Check(value.ptr()) != 0) return py::str(py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr())));
+    if (py::isinstance<py::float_>(value) || is_numpy_kind(value, 'f'))
+        return py::repr(py::float_(py::reinterpret_borrow<py::object>(value))).cast<std::string>();
     throw py::value_error(name + " must be a str, bool, int or float, got " + py::repr(value).cast<std::string>());
 }
 
@@ -232,8 +235,7 @@ py::array render_scene(py::handle scene_object, py::handle kind, py::handle size
     } catch (const Error& e) {
         throw py::value_error(std::string("shading: ") + e.what());
     }
-    ro.shading.ao_samples = static_cast<int>(small_count(ao_samples, "ao_samples", kMaxAoSamples));
-    if (ro.shading.ao_samples < 1) throw py::value_error("ao_samples must lie in [1, " + std::to_string(kMaxAoSamples) + "]");
+    ro.shading.ao_samples = static_cast<int>(small_count(ao_samples, "ao_samples", kMaxAoSamples, 1));
     // A copy: the render runs without the GIL, while Python may change the scene's camera.
     const Scene scene = scene_object.cast<const Scene&>();
     std::tie(ro.width, ro.height) = size.is_none() ? std::pair{scene.width, scene.height} : image_size(size);
@@ -253,7 +255,11 @@ std::shared_ptr<Scene> load(py::handle path) {
     } catch (py::error_already_set&) {
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
     }
-    const std::string spec = text(p, "path");
+    // A str path as the system names the file: os.fsencode gives back the bytes of a name that is not
+    // UTF-8 (Linux allows any), which os.listdir hands out as lone surrogates.
+    if (!py::isinstance<py::str>(p))
+        throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
+    const std::string spec = py::module_::import("os").attr("fsencode")(p).cast<std::string>();
     if (spec.find('\0') != std::string::npos) throw py::value_error("path must not contain a NUL character");
     py::gil_scoped_release unlocked;
     return std::make_shared<Scene>(load_scene(spec));
@@ -285,7 +291,21 @@ PYBIND11_MODULE(cellrt, m) {
     using namespace cellrt::python;
     m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
     m.attr("__version__") = CELLRT_VERSION_STRING;
-    py::register_exception<Error>(m, "Error", PyExc_ValueError);
+    static const py::exception<Error>& error_type = py::register_exception<Error>(m, "Error", PyExc_ValueError);
+    // The library's messages name files in the bytes the system gave, which need not be UTF-8: decoded
+    // strictly (pybind11's own translator) such a message came out empty. Bytes that are not UTF-8
+    // read as \xff escapes. Registered after register_exception's translator, so tried before it.
+    py::register_exception_translator([](std::exception_ptr thrown) {
+        try {
+            if (thrown) std::rethrow_exception(thrown);
+        } catch (const Error& e) {
+            const std::string_view what = e.what();
+            const py::object message = py::reinterpret_steal<py::object>(
+                PyUnicode_DecodeUTF8(what.data(), static_cast<Py_ssize_t>(what.size()), "backslashreplace"));
+            if (!message) throw py::error_already_set();
+            PyErr_SetObject(error_type.ptr(), message.ptr());
+        }
+    });
 
     py::class_<TreeReport>(m, "TreeReport", "A tree's build report: its shape, references per triangle, SAH cost")
         .def_readonly("nodes", &TreeReport::nodes)
@@ -404,7 +424,9 @@ PYBIND11_MODULE(cellrt, m) {
                  return s;
              }),
              py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")
-        .def_readwrite("name", &Scene::name)
+        .def_property(
+            "name", [](const Scene& s) { return s.name; },
+            [](Scene& s, py::handle value) { s.name = text(value, "name"); })
         .def_property_readonly(
             "triangles",
             [](py::object self) {
@@ -426,6 +448,17 @@ PYBIND11_MODULE(cellrt, m) {
                    std::to_string(s.width) + "x" + std::to_string(s.height) + ">";
         });
     refuse_second_init(scene);
+    // pickle's protocols 0 and 1 make an object through pybind11's base type, whose constructor threw a
+    // C++ exception that nothing caught: the interpreter aborted (found by review, 2026-12-06). These
+    // objects hold C++ state with no Python form, so every protocol, and copy.copy, is a TypeError.
+    for (const char* name : {"Accelerator", "Scene", "Camera", "Light", "AccelStats", "TreeReport"}) {
+        const py::object cls = m.attr(name);
+        cls.attr("__reduce_ex__") = py::cpp_function(
+            [](py::handle self, py::handle) -> py::object {
+                throw py::type_error(std::string("cannot pickle '") + Py_TYPE(self.ptr())->tp_name + "' object");
+            },
+            py::name("__reduce_ex__"), py::is_method(cls));
+    }
 
     m.def("load_scene", &load, py::arg("path"),
           "A view file (.json), a mesh (.obj, .ply, .gltf, .glb, and what else the library reads) or builtin:NAME[?tris=N&seed=S]; "

@@ -791,6 +791,16 @@ TEST_F(LoaderTest, ViewFileRejectsImpossibleCameras) {
          "camera up is parallel to the view direction"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 0, 0}}, {"fov_y_deg", 45}},
          "camera up has zero length"},
+        // Lengths float cannot square (found by review, 2026-12-06: the first was "up is parallel to
+        // the view direction", the second "look_at equals position").
+        {{{"position", {1e20, 0, 0}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 45}},
+         "camera look_at's distance from position is 1e+20: float arithmetic takes lengths from about 4e-23 to "
+         "1.8e19"},
+        {{{"position", {0, 0, 1e-30}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 45}},
+         "camera look_at's distance from position is 1e-30: float arithmetic takes lengths from about 4e-23 to "
+         "1.8e19"},
+        {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1e25, 0}}, {"fov_y_deg", 45}},
+         "camera up's length is 1e+25: float arithmetic takes lengths from about 4e-23 to 1.8e19"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 0}},
          "camera fov_y_deg = 0.000000 must lie in (0, 180)"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 180}},

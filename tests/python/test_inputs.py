@@ -208,8 +208,8 @@ def test_bad_render_arguments(tmp_path):
     refused(r"size\[0\] must be an integer", cellrt.render, scene, size=(-1, 5))
     refused(r"size: image size 0x5", cellrt.render, scene, size=(0, 5))
     refused(r"size: image size 65536x65536", cellrt.render, scene, size=(65536, 65536))
-    refused(r"ao_samples must lie in \[1, 64\]", cellrt.render, scene, shading="ao", ao_samples=0)
-    refused(r"ao_samples must be an integer in \[0, 64\], got 65", cellrt.render, scene, shading="ao", ao_samples=65)
+    refused(r"ao_samples must be an integer in \[1, 64\], got 0", cellrt.render, scene, shading="ao", ao_samples=0)
+    refused(r"ao_samples must be an integer in \[1, 64\], got 65", cellrt.render, scene, shading="ao", ao_samples=65)
     with pytest.raises(cellrt.Error, match="unknown accelerator"):
         cellrt.render(scene, kind="octree", size=(8, 8))
     scene.camera.look_at = scene.camera.position
@@ -339,3 +339,51 @@ def test_running_out_of_memory_while_converting_is_a_memory_error():
     acc = cellrt.Accelerator(TRI)
     with pytest.raises(MemoryError):
         acc.intersect(_OutOfMemory(), D)
+
+
+def test_numpy_scalars_count_as_what_they_hold():
+    # np.int64 was refused as a parameter value while np.float64 was taken; np.bool_ was taken as 1
+    # where Python's True is refused (found by review, 2026-12-06).
+    acc = cellrt.Accelerator(TRI, kind="kd", params={"leaf_size": np.int64(2), "perfect_splits": np.bool_(False),
+                                                       "empty_bonus": np.float32(0.25)})
+    assert acc.config == "kd+auto@empty_bonus=0.25,leaf_size=2,perfect_splits=false"
+    refused(r"threads must be an integer in \[0, 1024\], got True", cellrt.Accelerator, TRI, threads=np.bool_(True))
+    refused(r"size\[0\] must be an integer in \[0, 65536\], got True", cellrt.render, cellrt.Scene(TRI),
+            size=(np.bool_(True), 4))
+    assert cellrt.render(cellrt.Scene(TRI), size=(np.int64(4), np.uint8(3))).shape == (3, 4, 3)
+
+
+@pytest.mark.parametrize("make", [lambda: cellrt.Camera(), lambda: cellrt.Light(), lambda: cellrt.Scene(TRI),
+                                  lambda: cellrt.Accelerator(TRI, kind="kd"),
+                                  lambda: cellrt.Accelerator(TRI, kind="kd").stats,
+                                  lambda: cellrt.Accelerator(TRI, kind="kd").stats.tree])
+def test_objects_refuse_pickling_with_a_type_error(make):
+    # Protocols 0 and 1 went through pybind11's base type, whose constructor threw a C++ exception
+    # nothing caught: the interpreter aborted.
+    import copy
+    import pickle
+    obj = make()
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        with pytest.raises(TypeError, match="cannot pickle 'cellrt."):
+            pickle.dumps(obj, protocol=protocol)
+    with pytest.raises(TypeError):
+        copy.copy(obj)
+
+
+def test_paths_in_any_bytes_and_text_utf8_cannot_encode(tmp_path):
+    import os
+    # A file name that is not UTF-8 (Linux allows any bytes) reaches Python as lone surrogates; it
+    # loads, and a message naming such a file keeps its name (pybind11's strict decoding emptied it).
+    name = os.fsdecode(os.fsencode(str(tmp_path)) + b"/tri\xff.obj")
+    with open(os.fsencode(name), "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert len(cellrt.load_scene(name).triangles) == 1
+    missing = os.fsdecode(os.fsencode(str(tmp_path)) + b"/gone\xff.obj")
+    with pytest.raises(cellrt.Error, match=r"gone\\xff\.obj: no such file"):
+        cellrt.load_scene(missing)
+    refused(r"kind must be text that UTF-8 can encode, got '\\udcff'", cellrt.Accelerator, TRI, kind="\udcff")
+    scene = cellrt.Scene(TRI)
+    refused(r"name must be text that UTF-8 can encode", setattr, scene, "name", "\udcff")
+    refused(r"name must be a str, got 3", setattr, scene, "name", 3)
+    scene.name = "mine"
+    assert scene.name == "mine"
