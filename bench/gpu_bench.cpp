@@ -288,5 +288,5 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "cellrt_gpu_bench: error: %s\n", e.what());
         return 1;
     }
-    return 0;
+    return cli::cluster::flushed(0);
 }

@@ -102,12 +102,39 @@ void refuse_second_init(py::class_<T, Options...>& cls) {
         py::name("init_once"), py::is_method(cls), py::doc(doc.c_str()));
 }
 
+// Text the library made from a file's name, in whatever bytes the system gave: bytes that are not
+// UTF-8 come back as lone surrogates, as os.fsdecode gives them, so that the name round-trips.
+py::str decoded(const std::string& bytes) {
+    PyObject* text = PyUnicode_DecodeUTF8(bytes.data(), static_cast<Py_ssize_t>(bytes.size()), "surrogateescape");
+    if (!text) throw py::error_already_set();
+    return py::reinterpret_steal<py::str>(text);
+}
+
+// The reverse, for a name set from Python: lone surrogates back to the bytes they stand for.
+std::string encoded(py::handle value, const std::string& name) {
+    if (!py::isinstance<py::str>(value))
+        throw py::value_error(name + " must be a str, got " + py::repr(value).cast<std::string>());
+    PyObject* bytes = PyUnicode_AsEncodedString(value.ptr(), "utf-8", "surrogateescape");
+    if (!bytes) {
+        PyErr_Clear();
+        throw py::value_error(name + " must be text that UTF-8 can encode, got " + py::repr(value).cast<std::string>());
+    }
+    const std::string s = py::reinterpret_steal<py::bytes>(bytes);
+    if (s.find('\0') != std::string::npos)
+        throw py::value_error(name + " must not contain a NUL character, got " + py::repr(value).cast<std::string>());
+    return s;
+}
+
 // numpy's scalars count as what they hold: np.int64(2) as 2, np.bool_(True) as true, np.float32(0.5)
 // as 0.5 (np.int64 was refused, np.float64, a float subclass, taken).
 std::string param_value(py::handle value, const std::string& name) {
     if (py::isinstance<py::str>(value)) return text(value, name);
     if (is_bool(value)) return PyObject_IsTrue(value.ptr()) ? "true" : "false";
-    if (PyIndex_Check(value.ptr()) != 0) return py::str(py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr())));
+    if (PyIndex_Check(value.ptr()) != 0) {
+        const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+        if (!index) throw py::error_already_set();
+        return py::str(index);
+    }
     if (py::isinstance<py::float_>(value) || is_numpy_kind(value, 'f'))
         return py::repr(py::float_(py::reinterpret_borrow<py::object>(value))).cast<std::string>();
     throw py::value_error(name + " must be a str, bool, int or float, got " + py::repr(value).cast<std::string>());
@@ -387,7 +414,7 @@ PYBIND11_MODULE(cellrt, m) {
                                 throw py::value_error("fov_y_deg must be a number in (0, 180), got " +
                                                       py::repr(value).cast<std::string>());
                             };
-                            if (py::isinstance<py::bool_>(value) || PyNumber_Check(value.ptr()) == 0 ||
+                            if (is_bool(value) || PyNumber_Check(value.ptr()) == 0 ||
                                 PyComplex_Check(value.ptr()))
                                 refuse();
                             const double d = PyFloat_AsDouble(value.ptr());
@@ -416,17 +443,18 @@ PYBIND11_MODULE(cellrt, m) {
                  s->name = "numpy";
                  s->triangles = triangle_soup(triangles);
                  if (s->triangles.empty()) throw py::value_error("triangles must hold at least one triangle");
-                 try {
-                     set_default_view(*s);
-                 } catch (const Error& e) {
-                     throw py::value_error(std::string("triangles: ") + e.what());
+                 set_default_view(*s);
+                 // Not refused: the caller may give the scene a camera and light of its own.
+                 if (const std::string why = default_view_problem(*s); !why.empty()) {
+                     const std::string warning = "triangles: " + why + "; set scene.camera and scene.light";
+                     if (PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
                  }
                  return s;
              }),
              py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")
         .def_property(
-            "name", [](const Scene& s) { return s.name; },
-            [](Scene& s, py::handle value) { s.name = text(value, "name"); })
+            "name", [](const Scene& s) { return decoded(s.name); },
+            [](Scene& s, py::handle value) { s.name = encoded(value, "name"); })
         .def_property_readonly(
             "triangles",
             [](py::object self) {
@@ -444,8 +472,8 @@ PYBIND11_MODULE(cellrt, m) {
             "size", [](const Scene& s) { return py::make_tuple(s.width, s.height); },
             [](Scene& s, py::handle size) { std::tie(s.width, s.height) = image_size(size); }, "(width, height)")
         .def("__repr__", [](const Scene& s) {
-            return "<cellrt.Scene '" + s.name + "', " + std::to_string(s.triangles.size()) + " triangles, " +
-                   std::to_string(s.width) + "x" + std::to_string(s.height) + ">";
+            return decoded("<cellrt.Scene '" + s.name + "', " + std::to_string(s.triangles.size()) + " triangles, " +
+                           std::to_string(s.width) + "x" + std::to_string(s.height) + ">");
         });
     refuse_second_init(scene);
     // pickle's protocols 0 and 1 make an object through pybind11's base type, whose constructor threw a

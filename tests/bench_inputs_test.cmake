@@ -8,17 +8,27 @@ file(WRITE ${WORK}/mine.json "${mine}")
 file(MAKE_DIRECTORY ${WORK}/folder.json)
 set(small --scenes builtin:city?tris=300 --size 8x8 --repeats 1)
 
-# expect(MESSAGE PROGRAM ARGS...): the program fails with status 1 and prints exactly MESSAGE.
-function(expect message program)
+# expect(MESSAGE PROGRAM ARGS...): the program fails with status 1 and prints exactly MESSAGE;
+# expect_start: the message begins with MESSAGE (where the rest depends on the build: Embree's kind).
+function(expect_start message program)
   execute_process(COMMAND ${program} ${ARGN} OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
   get_filename_component(name ${program} NAME)
-  if(NOT rc EQUAL 1 OR NOT err STREQUAL "${name}: error: ${message}\n")
+  string(FIND "${err}" "${name}: error: ${message}" at)
+  if(NOT rc EQUAL 1 OR NOT at EQUAL 0)
     message(FATAL_ERROR "${name} ${ARGN}: status ${rc}, printed '${err}', expected '${name}: error: ${message}'")
+  endif()
+  set(printed "${err}" PARENT_SCOPE)
+endfunction()
+function(expect message program)
+  expect_start("${message}" ${program} ${ARGN})
+  get_filename_component(name ${program} NAME)
+  if(NOT printed STREQUAL "${name}: error: ${message}\n")
+    message(FATAL_ERROR "${name} ${ARGN}: printed '${printed}', expected '${name}: error: ${message}'")
   endif()
 endfunction()
 
-expect("--configs 'bogus': unknown accelerator 'bogus' (choose one of: brute, kd, bih, bvh, auto, embree)"
-       ${BENCH} ${small} --configs bogus)
+expect_start("--configs 'bogus': unknown accelerator 'bogus' (choose one of: brute, kd, bih, bvh, auto"
+             ${BENCH} ${small} --configs bogus)
 expect("--configs 'kd:nope': unknown traversal 'nope' of kd (choose one of: branched, rec, branchless)"
        ${BENCH} ${small} --configs kd:nope)
 expect("--scenes nosuch: ${WORK}/nosuch/nosuch.json not found"

@@ -345,15 +345,13 @@ TEST(Cli, AnErrorOnARenderWorkerIsTheProgramsError) {
     }
 }
 
-// A scene named after a file whose name is not UTF-8 still gets its JSON report (nlohmann::json
-// would throw on the bytes once the render is done); they become U+FFFD.
 // A report printed into a full disk is lost: `cellrt info` into /dev/full ended with status 0 (found by
 // review, 2026-12-06); now it says so and ends with 1.
 TEST(Cli, OutputThatCannotBeWrittenIsAnError) {
     if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
     TempDir dir;
     const std::string errors = (dir.path / "errors.txt").string();
-    for (const std::string args : {"info builtin:city?tris=300", "info --params kd"}) {
+    for (const std::string args : {"info 'builtin:city?tris=300'", "info --params kd"}) {
         const int status = std::system((std::string(CELLRT_CLI) + " " + args + " > /dev/full 2> " + errors).c_str());
         ASSERT_TRUE(WIFEXITED(status)) << args;
         EXPECT_EQ(WEXITSTATUS(status), 1) << args;
@@ -364,6 +362,8 @@ TEST(Cli, OutputThatCannotBeWrittenIsAnError) {
     }
 }
 
+// A scene named after a file whose name is not UTF-8 still gets its JSON report (nlohmann::json
+// would throw on the bytes once the render is done); they become U+FFFD.
 TEST(Cli, StatsOfAFileNamedInAnyBytes) {
     TempDir dir;
     const std::string mesh = (dir.path / "\xff\xfe.obj").string(), stats = (dir.path / "stats.json").string();

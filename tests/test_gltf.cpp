@@ -200,6 +200,28 @@ TEST_F(GltfTest, TheFirstPerspectiveCameraIsTheView) {
     EXPECT_EQ(plain.width, 512);
 }
 
+// A mesh too large for the default camera (a quad scaled to 1e19) is refused naming its span, but
+// with a camera of its own the file loads: only the default light must be placed then (found by
+// review, 2026-12-06, when the default view's check ran before the file's camera replaced it).
+TEST_F(GltfTest, ALargeMeshLoadsWithItsOwnCamera) {
+    json doc = quad_document();
+    doc["nodes"][0]["scale"] = {1e19, 1e19, 1e19};
+    const std::string bare = embedded(doc);
+    try {
+        load_scene(bare);
+        ADD_FAILURE() << "a mesh the default view cannot frame was loaded";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("which the default view cannot frame in float arithmetic"),
+                  std::string::npos)
+            << e.what();
+    }
+    doc["cameras"] = json::parse(R"([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}])");
+    doc["nodes"].push_back(json::parse(R"({"camera": 0, "translation": [0, 0, 5]})"));
+    doc["scenes"][0]["nodes"] = {0, 1};
+    const Scene s = load_scene(embedded(doc));
+    EXPECT_EQ(s.camera.position, (Vec3{0.f, 0.f, 5.f}));
+}
+
 TEST_F(GltfTest, BadFilesAreRefusedNamingThePartAtFault) {
     auto with = [](const char* pointer, json value) {
         json doc = quad_document();

@@ -22,6 +22,7 @@
 #include "cellrt/camera.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/render.hpp"
+#include "core/files.hpp"
 #include "error_of.hpp"
 #include "sanitizers.hpp"
 
@@ -111,7 +112,8 @@ TEST(Render, WritesPfmExactlyAndRefusesToOverwrite) {
 // What an image is written to when it is not a plain new file: a pipe (as /dev/null or /dev/stdout,
 // which renaming over would have replaced by a file: found by review, 2026-12-06) is written in place
 // and stays a pipe; a link to a file keeps its link and the file is replaced; a folder is refused; a
-// name of 250 bytes, whose temporary name would pass the file system's 255, is written.
+// name of 250 bytes, whose temporary name would pass the file system's 255, is written; a path under
+// /proc (or /dev) that leads to a log file is appended to.
 TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     const Image img = render_with(make_builtin_scene("builtin:spheres?tris=400"), "brute", 2, 4, 2);
     const auto dir = std::filesystem::temp_directory_path() / ("cellrt_out_" + std::to_string(::getpid()));
@@ -145,6 +147,16 @@ TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     const std::string long_name = (dir / (std::string(246, 'a') + ".pfm")).string();
     write_image(img, long_name, false);
     EXPECT_TRUE(same_bits(read_pfm(long_name), img));
+    // A path under /proc (or /dev, as /dev/stdout) that leads to a file, as a shell's `>> log` makes
+    // it: appended to, not renamed over nor truncated.
+    const std::string log = (dir / "log.txt").string();
+    std::ofstream(log) << "first\n";
+    const int fd = ::open(log.c_str(), O_WRONLY | O_APPEND);
+    ASSERT_GE(fd, 0);
+    write_file_atomically("/proc/self/fd/" + std::to_string(fd), "second\n", false);
+    ::close(fd);
+    std::ifstream logged(log);
+    EXPECT_EQ((std::string{std::istreambuf_iterator<char>(logged), std::istreambuf_iterator<char>()}), "first\nsecond\n");
     std::filesystem::remove_all(dir);
 }
 

@@ -39,10 +39,15 @@ struct Scene {
 Scene load_scene(const std::string& spec);
 
 // A camera looking at the whole of `bounds` from the front-upper-right and a light above it; used
-// for bare meshes. Throws cellrt::Error when that view cannot be made in float arithmetic: for a
-// mesh around the origin, from coordinates of about 4e18 on (the camera's distance, squared,
-// overflows), or for a mesh too small for its distance from the origin.
+// for bare meshes.
 void set_default_view(Scene& scene);
+
+// Why the default view that set_default_view gave `scene` (its light, and its camera too where
+// `camera_too`) cannot frame its triangles in float arithmetic, as a message naming their span; ""
+// where it can, or where a triangle is not finite (validate_scene names it). For a mesh around the
+// origin the view fails from coordinates of about 4e18 on (the camera's distance, squared,
+// overflows), and for a mesh too small for its distance from the origin.
+std::string default_view_problem(const Scene& scene, bool camera_too = true);
 
 // Checks what every loader guarantees: at least one triangle, all coordinates finite, a valid camera
 // (see PinholeCamera) and a positive image size. Throws cellrt::Error naming `where` otherwise.

@@ -17,16 +17,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// What `path` names once links are followed: a regular file, a folder, something else (a device, a
-// pipe, a socket), or nothing.
-enum class Target { none, file, folder, other };
+// What `path` names once links are followed: a regular file, a folder, a stream (a device, a pipe, a
+// socket), or nothing. A path the system keeps under /dev or /proc counts as a stream whatever it
+// leads to: /dev/stdout redirected to a log file leads to a regular file, which renaming over would
+// replace (and truncating would wipe).
+enum class Target { none, file, folder, stream };
 
 Target target_of(const std::string& path) {
     std::error_code ec;
     const fs::file_status st = fs::status(path, ec);
     if (!fs::exists(st)) return Target::none;
     if (fs::is_directory(st)) return Target::folder;
-    return fs::is_regular_file(st) ? Target::file : Target::other;
+    const bool system = path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
+    return fs::is_regular_file(st) && !system ? Target::file : Target::stream;
 }
 
 // The file an existing path names, links followed, so that its folder takes the temporary file and
@@ -46,8 +49,9 @@ fs::path file_named(const std::string& path) {
 
 fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
 
+// Appended, so that a stream that leads to a file (a shell's `> log`) is not truncated.
 void write_in_place(const std::string& path, std::string_view bytes) {
-    std::ofstream out(path, std::ios::binary);
+    std::ofstream out(path, std::ios::binary | std::ios::app);
     if (!out) throw Error(path + ": cannot be opened for writing");
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.close();
@@ -65,7 +69,7 @@ std::string lower_extension(const std::string& path) {
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite) {
     const Target kind = target_of(path);
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
-    if (kind == Target::other) return write_in_place(path, bytes);
+    if (kind == Target::stream) return write_in_place(path, bytes);
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists and overwrite is off");
     const fs::path target = kind == Target::file ? resolved(path) : fs::path(path);
     const fs::path dir = folder_of(target);
@@ -99,7 +103,7 @@ void check_output_file(const std::string& path, bool overwrite) {
     if (path.empty()) throw Error("an output file's name is empty");
     const Target kind = target_of(path);
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
-    if (kind == Target::other) {  // written in place
+    if (kind == Target::stream) {  // written in place
         if (::access(path.c_str(), W_OK) != 0) {
             const int error = errno;
             throw Error(path + ": cannot be written (" + std::strerror(error) + ")");
@@ -136,7 +140,7 @@ void check_distinct_files(const std::vector<std::pair<std::string, std::string>>
                           const std::vector<std::pair<std::string, std::string>>& inputs) {
     for (std::size_t i = 0; i < outputs.size(); ++i) {
         const auto& [option, path] = outputs[i];
-        if (path.empty()) continue;
+        if (path.empty() || target_of(path) == Target::stream) continue;  // /dev/null may take both
         for (std::size_t j = 0; j < i; ++j)
             if (!outputs[j].second.empty() && file_named(outputs[j].second) == file_named(path))
                 throw Error(option + " " + path + " names the same file as " + outputs[j].first + " " +

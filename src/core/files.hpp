@@ -12,8 +12,9 @@ namespace cellrt {
 // Writes `bytes` beside `path` under a temporary name and renames it into place, so an interrupted
 // write never leaves a partial file under `path`. Refuses to replace an existing file unless
 // `overwrite`, and a folder always. A link to a file is followed: the file is replaced, the link
-// kept. A device or a pipe (/dev/null, /dev/stdout) is written in place, never renamed over: it is
-// not a file whose contents could be lost, and renaming over it would replace the device node.
+// kept. A device, a pipe or any path under /dev or /proc (/dev/null, /dev/stdout) is appended to in
+// place, never renamed over: it is not a file whose contents could be lost, and renaming over it
+// would replace the device node (or a log file that /dev/stdout leads to).
 // Throws cellrt::Error naming the path on any failure (missing directory, no permission, disk full).
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite);
 

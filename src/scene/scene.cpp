@@ -34,24 +34,28 @@ void set_default_view(Scene& scene) {
     scene.camera.up = {0.f, 1.f, 0.f};
     scene.light.position = c + Vec3{-0.6f, 1.5f, 0.9f} * (radius * 2.f);
     scene.light.color = {1.f, 1.f, 1.f};
-    // Finite triangles can still defeat this view in float arithmetic: a mesh so large that a length
-    // overflows (the extent's, or the camera's distance to the centre, whose square passes float's
-    // range from about 1.8e19: coordinates of about 4e18 around the origin), or one so small for
-    // its distance from the origin that the camera rounds onto the centre. Said here, where the
-    // cause is known, rather than later as a camera or light at fault. Non-finite triangles are left
-    // to validate_scene, which names the first of them.
-    if (!is_finite(b.lo) || !is_finite(b.hi)) return;
+}
+
+// Finite triangles can still defeat the default view in float arithmetic: a mesh so large that a
+// length overflows (the extent's, or the camera's distance to the centre, whose square passes
+// float's range from about 1.8e19: coordinates of about 4e18 around the origin), or one so small for
+// its distance from the origin that the camera rounds onto the centre. Said where the cause is
+// known, rather than later as a camera or light at fault. Non-finite triangles are left to
+// validate_scene, which names the first of them.
+std::string default_view_problem(const Scene& scene, bool camera_too) {
+    const Box3 b = scene.bounds();
+    if (!is_finite(b.lo) || !is_finite(b.hi)) return {};
     bool framed = is_finite(scene.light.position);
-    try {
-        PinholeCamera(scene.camera, 1, 1);
-    } catch (const Error&) {
-        framed = false;
-    }
-    if (!framed) {
-        char span[160];
-        std::snprintf(span, sizeof span, "(%.9g, %.9g, %.9g) to (%.9g, %.9g, %.9g)", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
-        throw Error(std::string("the mesh spans ") + span + ", which the default view cannot frame in float arithmetic");
-    }
+    if (camera_too) try {
+            PinholeCamera(scene.camera, 1, 1);
+        } catch (const Error&) {
+            framed = false;
+        }
+    if (framed) return {};
+    char span[160];
+    std::snprintf(span, sizeof span, "(%.9g, %.9g, %.9g) to (%.9g, %.9g, %.9g)", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
+                  b.hi.y, b.hi.z);
+    return std::string("the mesh spans ") + span + ", which the default view cannot frame in float arithmetic";
 }
 
 void validate_scene(const Scene& scene, const std::string& where) {
@@ -96,14 +100,12 @@ Scene load_scene(const std::string& spec) {
         scene.triangles = load_mesh(spec);
     }
     if (scene.triangles.empty()) throw Error(spec + ": the mesh has no triangles");
-    try {
-        set_default_view(scene);
-    } catch (const Error& e) {
-        throw Error(spec + ": " + e.what() + "; give it a view file with its own camera and light (docs/SCENES.md)");
-    }
+    set_default_view(scene);
     // A glTF file's first perspective camera is its view; the light stays the default one's, and
     // the camera's aspect ratio, where given, sets the width beside the default height.
     if (camera) scene.camera = *camera;
+    if (const std::string why = default_view_problem(scene, !camera); !why.empty())
+        throw Error(spec + ": " + why + "; give it a view file with its own camera and light (docs/SCENES.md)");
     if (aspect)
         scene.width = static_cast<int>(std::lround(
             std::clamp(static_cast<double>(scene.height) * *aspect, 1.0, static_cast<double>(kMaxImageSide))));

@@ -124,7 +124,10 @@ public:
         std::string key_name;  // the field the next object or value is, as "camera.position"
         const json::parser_callback_t once = [&](int, json::parse_event_t event, json& parsed) {
             if (event == json::parse_event_t::object_start) objects.push_back({key_name, {}});
-            if (event == json::parse_event_t::object_end && !objects.empty()) objects.pop_back();
+            if (event == json::parse_event_t::object_end && !objects.empty()) {
+                key_name = objects.back().name;  // the next object in an array is named as this one
+                objects.pop_back();
+            }
             if (event == json::parse_event_t::key && !objects.empty()) {
                 Object& o = objects.back();
                 const std::string k = parsed.get<std::string>();

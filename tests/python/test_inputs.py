@@ -190,13 +190,20 @@ def test_bad_scene_files(tmp_path):
 
 def test_triangles_too_large_for_the_default_view():
     # The default view's camera would lie beyond float's range: said when the scene is made, with
-    # the mesh's span, not later as a camera the caller never gave. 1e18 is still framed.
+    # the mesh's span, as a warning (the caller may set a camera and light of its own), not first
+    # at render as a camera the caller never gave. 1e18 is still framed, without a warning.
+    import warnings
     for x in (1e38, 5e18):
         huge = np.array([[[x, x, x], [-x, -x, -x], [x, -x, 0]]], np.float32)
-        refused(r"triangles: the mesh spans \(-.*\), which the default view cannot frame in float arithmetic",
-                cellrt.Scene, huge)
+        with pytest.warns(RuntimeWarning, match=r"triangles: the mesh spans \(-.*\), which the default view cannot "
+                                                r"frame in float arithmetic; set scene.camera and scene.light"):
+            scene = cellrt.Scene(huge)
+        with pytest.raises(cellrt.Error, match="camera"):
+            cellrt.render(scene, size=(4, 4))
     large = np.array([[[1e18, 1e18, 1e18], [-1e18, -1e18, -1e18], [1e18, -1e18, 0]]], np.float32)
-    assert cellrt.render(cellrt.Scene(large), size=(4, 4)).shape == (4, 4, 3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert cellrt.render(cellrt.Scene(large), size=(4, 4)).shape == (4, 4, 3)
 
 
 def test_bad_render_arguments(tmp_path):
@@ -225,7 +232,7 @@ def test_bad_scene_properties():
     refused(r"size\[1\] must be an integer", setattr, scene, "size", (5, 2.5))
     # The field of view is checked when set, as the vectors are, not first at render; 179.99999999
     # is 180 as a float32, the camera's type.
-    for fov in (np.nan, 0, 180, 179.99999999, -5, np.inf, "45", True, None, 1j):
+    for fov in (np.nan, 0, 180, 179.99999999, -5, np.inf, "45", True, np.bool_(True), None, 1j):
         refused(r"fov_y_deg must be a number in \(0, 180\), got ", setattr, scene.camera, "fov_y_deg", fov)
     camera = cellrt.Camera()
     camera.fov_y_deg = np.float32(30)
@@ -377,13 +384,15 @@ def test_paths_in_any_bytes_and_text_utf8_cannot_encode(tmp_path):
     name = os.fsdecode(os.fsencode(str(tmp_path)) + b"/tri\xff.obj")
     with open(os.fsencode(name), "w") as f:
         f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    assert len(cellrt.load_scene(name).triangles) == 1
+    loaded = cellrt.load_scene(name)
+    assert len(loaded.triangles) == 1
+    assert loaded.name == "tri\udcff" and "tri" in repr(loaded)  # the name round-trips as os.fsdecode's
     missing = os.fsdecode(os.fsencode(str(tmp_path)) + b"/gone\xff.obj")
     with pytest.raises(cellrt.Error, match=r"gone\\xff\.obj: no such file"):
         cellrt.load_scene(missing)
     refused(r"kind must be text that UTF-8 can encode, got '\\udcff'", cellrt.Accelerator, TRI, kind="\udcff")
     scene = cellrt.Scene(TRI)
-    refused(r"name must be text that UTF-8 can encode", setattr, scene, "name", "\udcff")
+    refused(r"name must be text that UTF-8 can encode", setattr, scene, "name", "\ud800")
     refused(r"name must be a str, got 3", setattr, scene, "name", 3)
     scene.name = "mine"
     assert scene.name == "mine"
