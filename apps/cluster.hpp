@@ -82,10 +82,10 @@ inline int flushed(int status) {
 }
 
 // Integer options read as decimal digits only (no sign, no leading zero), and numbers as
-// std::from_chars reads them, finite: CLI11 (2.1)
-// reads integers by strtoll's rules, so that `--threads 010` meant 8, `0x10` 16 and " 4" 4, and `""`
-// 0, where the values in files and -P are decimal. Added to every option of `app` and its
-// subcommands whose type is INT, UINT or FLOAT (call it after the options are made).
+// std::from_chars reads them, finite: CLI11 (2.1) reads integers by strtoll's rules, so that
+// `--threads 010` meant 8, `0x10` 16, " 4" 4 and "" 0, where the values in files and -P are decimal.
+// Added to every option of `app` and its subcommands whose type is INT, UINT or FLOAT (call it after
+// the options are made).
 inline void strict_numbers(CLI::App& app) {
     const auto kind = [](const CLI::Option* o) {
         const std::string t = o->get_type_name();
