@@ -15,6 +15,7 @@
 
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
+#include "kernel/named.hpp"
 
 namespace cellrt::bench {
 
@@ -83,11 +84,8 @@ inline void check_configs(const std::vector<std::string>& configs) {
             if (c.kind == "embree" && std::find(kinds.begin(), kinds.end(), c.kind) == kinds.end()) continue;
             const auto& traversals = accelerator_traversals(c.kind);  // refuses an unknown kind, naming the kinds
             if (!c.traversal.empty() && std::find(traversals.begin(), traversals.end(), c.traversal) == traversals.end())
-            {
-                std::string names;
-                for (const std::string& t : traversals) names += (names.empty() ? "" : ", ") + t;
-                throw Error("unknown traversal '" + c.traversal + "' of " + c.kind + " (choose one of: " + names + ")");
-            }
+                throw Error("unknown traversal '" + c.traversal + "' of " + c.kind + " (choose one of: " +
+                            detail::join_names(traversals) + ")");
         } catch (const Error& e) {
             throw Error("--configs '" + text + "': " + e.what());
         }

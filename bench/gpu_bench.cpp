@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
     try {
         if (!o.json_path.empty()) check_output_file(o.json_path, o.overwrite);
     } catch (const Error& e) {
-        std::fprintf(stderr, "cellrt_gpu_bench: error: %s\n", e.what());
+        cli::cluster::print_error(e);
         return 1;
     }
     const DeviceInfo gpu = cuda_device_info();

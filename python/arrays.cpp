@@ -223,15 +223,15 @@ unsigned small_count(py::handle object, const std::string& name, unsigned max, u
     return static_cast<unsigned>(value);
 }
 
-std::string text(py::handle object, const std::string& name) {
+std::string text(py::handle object, const std::string& name, bool file_name) {
     if (!py::isinstance<py::str>(object))
         throw py::value_error(name + " must be a str, got " + py::repr(object).cast<std::string>());
-    std::string s;
-    try {
-        s = object.cast<std::string>();
-    } catch (const py::cast_error&) {  // a lone surrogate, which UTF-8 cannot encode
+    PyObject* bytes = PyUnicode_AsEncodedString(object.ptr(), "utf-8", file_name ? "surrogateescape" : "strict");
+    if (!bytes) {
+        PyErr_Clear();
         throw py::value_error(name + " must be text that UTF-8 can encode, got " + py::repr(object).cast<std::string>());
     }
+    const std::string s = py::reinterpret_steal<py::bytes>(bytes);
     // The library's messages are C strings: a NUL would cut the name it is refused with.
     if (s.find('\0') != std::string::npos)
         throw py::value_error(name + " must not contain a NUL character, got " + py::repr(object).cast<std::string>());

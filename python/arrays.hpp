@@ -62,8 +62,10 @@ bool is_bool(py::handle object);
 // Python's or numpy's, is refused too.
 unsigned small_count(py::handle object, const std::string& name, unsigned max, unsigned min = 0);
 
-// A str argument; ValueError naming `name` for anything else.
-std::string text(py::handle object, const std::string& name);
+// A str argument as UTF-8 bytes; ValueError naming `name` for anything else, for text UTF-8 cannot
+// encode (a lone surrogate) and for a NUL. With `file_name`, lone surrogates become the bytes they
+// stand for, as os.fsencode makes them: a name the system gave in bytes that are not UTF-8.
+std::string text(py::handle object, const std::string& name, bool file_name = false);
 
 // The array's shape as Python prints it: "(5, 4)".
 std::string shape_of(const py::array& a);

@@ -110,21 +110,6 @@ py::str decoded(const std::string& bytes) {
     return py::reinterpret_steal<py::str>(text);
 }
 
-// The reverse, for a name set from Python: lone surrogates back to the bytes they stand for.
-std::string encoded(py::handle value, const std::string& name) {
-    if (!py::isinstance<py::str>(value))
-        throw py::value_error(name + " must be a str, got " + py::repr(value).cast<std::string>());
-    PyObject* bytes = PyUnicode_AsEncodedString(value.ptr(), "utf-8", "surrogateescape");
-    if (!bytes) {
-        PyErr_Clear();
-        throw py::value_error(name + " must be text that UTF-8 can encode, got " + py::repr(value).cast<std::string>());
-    }
-    const std::string s = py::reinterpret_steal<py::bytes>(bytes);
-    if (s.find('\0') != std::string::npos)
-        throw py::value_error(name + " must not contain a NUL character, got " + py::repr(value).cast<std::string>());
-    return s;
-}
-
 // numpy's scalars count as what they hold: np.int64(2) as 2, np.bool_(True) as true, np.float32(0.5)
 // as 0.5 (np.int64 was refused, np.float64, a float subclass, taken).
 std::string param_value(py::handle value, const std::string& name) {
@@ -282,12 +267,11 @@ std::shared_ptr<Scene> load(py::handle path) {
     } catch (py::error_already_set&) {
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
     }
-    // A str path as the system names the file: os.fsencode gives back the bytes of a name that is not
-    // UTF-8 (Linux allows any), which os.listdir hands out as lone surrogates.
+    // A str path as the system names the file: the bytes of a name that is not UTF-8 (Linux allows
+    // any), which os.listdir hands out as lone surrogates.
     if (!py::isinstance<py::str>(p))
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
-    const std::string spec = py::module_::import("os").attr("fsencode")(p).cast<std::string>();
-    if (spec.find('\0') != std::string::npos) throw py::value_error("path must not contain a NUL character");
+    const std::string spec = text(p, "path", true);
     py::gil_scoped_release unlocked;
     return std::make_shared<Scene>(load_scene(spec));
 }
@@ -454,7 +438,7 @@ PYBIND11_MODULE(cellrt, m) {
              py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")
         .def_property(
             "name", [](const Scene& s) { return decoded(s.name); },
-            [](Scene& s, py::handle value) { s.name = encoded(value, "name"); })
+            [](Scene& s, py::handle value) { s.name = text(value, "name", true); })
         .def_property_readonly(
             "triangles",
             [](py::object self) {

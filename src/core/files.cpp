@@ -32,15 +32,8 @@ Target target_of(const std::string& path) {
     return fs::is_regular_file(st) && !system ? Target::file : Target::stream;
 }
 
-// The file an existing path names, links followed, so that its folder takes the temporary file and
-// the rename replaces the file, not the link.
-fs::path resolved(const std::string& path) {
-    std::error_code ec;
-    const fs::path p = fs::canonical(path, ec);
-    return ec ? fs::path(path) : p;
-}
-
-// A path as the file it names: links and dots resolved where the system can, else as written.
+// A path as the file it names: links and dots resolved where the system can, else as written. For an
+// existing file, its folder takes the temporary file and the rename replaces the file, not the link.
 fs::path file_named(const std::string& path) {
     std::error_code ec;
     const fs::path p = fs::weakly_canonical(path, ec);
@@ -71,7 +64,7 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
     if (kind == Target::stream) return write_in_place(path, bytes);
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists and overwrite is off");
-    const fs::path target = kind == Target::file ? resolved(path) : fs::path(path);
+    const fs::path target = kind == Target::file ? file_named(path) : fs::path(path);
     const fs::path dir = folder_of(target);
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");
@@ -111,7 +104,7 @@ void check_output_file(const std::string& path, bool overwrite) {
         return;
     }
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists (pass --overwrite to replace it)");
-    const fs::path dir = folder_of(kind == Target::file ? resolved(path) : fs::path(path));
+    const fs::path dir = folder_of(kind == Target::file ? file_named(path) : fs::path(path));
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": no folder " + dir.string() + " to write it in");
     if (::access(dir.c_str(), W_OK | X_OK) != 0) {  // the temporary file is made there
