@@ -109,10 +109,12 @@ inline void strict_numbers(CLI::App& app) {
             return whole ? std::string() : "'" + value + "' is not a finite decimal number";
         },
         "", "decimal number");
+    // Put ahead of the option's own checks (transform inserts first; these change nothing), so that
+    // `--repeats ""` is named as not a number rather than as "Value  not in range 1 to 1000".
     for (CLI::Option* o : app.get_options()) {
         const std::string k = kind(o);
-        if (k == "INT" || k == "UINT") o->check(integer);
-        else if (k == "FLOAT") o->check(number);
+        if (k == "INT" || k == "UINT") o->transform(integer);
+        else if (k == "FLOAT") o->transform(number);
     }
     for (CLI::App* sub : app.get_subcommands({})) strict_numbers(*sub);
 }

@@ -77,7 +77,7 @@ struct Options {
     std::vector<std::string> configs{"embree:single", "kd+auto", "bih+auto", "kd:branched"};
     std::vector<std::string> dispatches{"pull", "mailbox"};
     std::vector<int> packets{2, 8, 16};
-    std::vector<unsigned> workers;  // sorted, without repeats
+    std::vector<unsigned> workers;  // sorted; repeats refused
     int repeats = 3;
     std::string size = "512x512";
     ShadingOptions shading;  // every frame's, the yardstick's too
@@ -153,6 +153,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         cluster::check_no_repeats("--scenes", o.scenes);
         cluster::check_no_repeats("--dispatch", o.dispatches);
         cluster::check_no_repeats("--packets", o.packets);
+        cluster::check_no_repeats("--workers", o.workers);
         for (const unsigned w : o.workers)
             if (w < 1 || w > kMaxWorkers)
                 throw Error("--workers " + std::to_string(w) + " must lie in [1, " + std::to_string(kMaxWorkers) + "]");
@@ -163,7 +164,6 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     if (o.workers.empty())
         for (unsigned w = 1; w <= cores; ++w) o.workers.push_back(w);
     std::sort(o.workers.begin(), o.workers.end());  // efficiencies are against the fewest
-    o.workers.erase(std::unique(o.workers.begin(), o.workers.end()), o.workers.end());
     return std::nullopt;
 }
 

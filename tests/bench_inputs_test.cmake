@@ -35,6 +35,8 @@ expect("--scenes nosuch: ${WORK}/nosuch/nosuch.json not found"
        ${BENCH} --scenes-dir ${WORK} --scenes nosuch --configs kd --size 8x8 --repeats 1)
 expect("--threads 100000 must lie in [0, 1024]" ${BENCH} ${small} --configs kd --threads 100000)
 expect("--builds: '010' is not a whole number in decimal digits (see --help)" ${BENCH} ${small} --configs kd --builds 010)
+# Named as not a number before the option's range is checked ("Value -1 not in range 1 to 100").
+expect("--builds: '-1' is not a whole number in decimal digits (see --help)" ${BENCH} ${small} --configs kd --builds -1)
 expect("The following argument was not expected: --bogus (see --help)" ${SCALING} ${small} --configs kd --bogus)
 expect("--configs names 'kd' twice" ${BENCH} ${small} --configs kd kd)
 expect("--packets names '8' twice" ${SCALING} ${small} --configs kd --packets 8 8)
@@ -42,6 +44,7 @@ expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${BENCH} ${small} --configs kd --json ${WORK}/mine.json)
 expect("${WORK}/folder.json: is a folder, not a file" ${BENCH} ${small} --configs kd --json ${WORK}/folder.json)
 expect("--workers 0 must lie in [1, 1024]" ${SCALING} ${small} --configs kd --workers 0)
+expect("--workers names '2' twice" ${SCALING} ${small} --configs kd --workers 2 1 2)
 expect("--csv ${WORK}/x.json names the same file as --json ${WORK}/x.json"
        ${SCALING} ${small} --configs kd --workers 1 --json ${WORK}/x.json --csv ${WORK}/x.json)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
