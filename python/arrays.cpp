@@ -15,11 +15,17 @@ py::module_ numpy() { return py::module_::import("numpy"); }
 std::string message_of(const py::error_already_set& e) { return py::str(e.value()).cast<std::string>(); }
 
 py::array as_array(py::handle object, const std::string& name) {
+    // numpy reads a masked array's data under its mask too: the entries the caller masked out would be
+    // traced or built as if they were not.
+    const py::object ma = numpy().attr("ma");
+    if (py::isinstance(object, ma.attr("MaskedArray")) && ma.attr("is_masked")(object).cast<bool>())
+        throw py::value_error(name + " is a masked array with masked entries, whose values would be used; pass " +
+                              name + ".filled(...) or only the rows to use");
     if (py::isinstance<py::array>(object)) return py::reinterpret_borrow<py::array>(object);
     try {
         return numpy().attr("asarray")(object);
     } catch (py::error_already_set& e) {
-        if (e.matches(PyExc_MemoryError)) throw;  // running out of memory says nothing of the argument
+        if (passes_through(e)) throw;
         throw py::value_error(name + " is not an array: " + message_of(e));
     }
 }
@@ -37,7 +43,7 @@ py::array required(const py::array& a, const char* dtype, const std::string& nam
     try {
         return numpy().attr("require")(a, dtype, "CA");
     } catch (py::error_already_set& e) {
-        if (e.matches(PyExc_MemoryError)) throw;
+        if (passes_through(e)) throw;
         throw py::value_error(name + " cannot be converted to " + dtype + ": " + message_of(e));
     }
 }
@@ -67,18 +73,30 @@ void check_triangle_count(std::size_t count, const std::string& name) {
 
 }  // namespace
 
+bool passes_through(const py::error_already_set& e) {
+    return e.matches(PyExc_MemoryError) || !e.matches(PyExc_Exception);
+}
+
 std::string shape_of(const py::array& a) {
     std::string s = "(";
     for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
     return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
-FloatRows float_rows(py::handle object, const std::string& name, std::size_t columns) {
+py::array row_array(py::handle object, const std::string& name, std::size_t columns) {
     const py::array a = as_array(object, name);
     if (a.ndim() != 2 || a.shape(1) != static_cast<py::ssize_t>(columns))
         throw py::value_error(name + " must have shape (N, " + std::to_string(columns) + "), got " + shape_of(a));
     check_real(a, name);
-    return rows_of(a, name, static_cast<std::size_t>(a.shape(0)));
+    return a;
+}
+
+FloatRows float_rows(const py::array& rows, const std::string& name) {
+    return rows_of(rows, name, static_cast<std::size_t>(rows.shape(0)));
+}
+
+FloatRows float_rows(py::handle object, const std::string& name, std::size_t columns) {
+    return float_rows(row_array(object, name, columns), name);
 }
 
 FloatRows triangle_rows(py::handle object, const std::string& name) {
@@ -87,15 +105,66 @@ FloatRows triangle_rows(py::handle object, const std::string& name) {
         throw py::value_error(name + " must have shape (M, 3, 3), got " + shape_of(a) +
                               " (vertices of shape (N, 3) need faces)");
     check_real(a, name);
+    check_triangle_count(static_cast<std::size_t>(a.shape(0)), name);  // before a copy of them all is made
     return rows_of(a, name, static_cast<std::size_t>(a.shape(0)));
 }
 
-Bound ray_bound(py::handle object, const std::string& name, std::size_t rays) {
+namespace {
+
+// `x` as the float32 on the bound's inner side: the nearest float, stepped once toward the inside where
+// rounding to nearest crossed `x` (tfar = 1 - 1e-8 in float64 is 1.0f to nearest, which would let a hit
+// at t = 1 through).
+template <class T>
+float inner_float(T x, Inward inward) {
+    float f = static_cast<float>(x);
+    if (inward == Inward::down && static_cast<T>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    if (inward == Inward::up && static_cast<T>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
+}
+
+// The bound's values as float32: float32 read as they are, other floats and integers rounded inward,
+// compared exactly in a type that holds both (integers in 128 bits: a float past 2^63 is still an
+// integer there).
+py::array_t<float> inner_floats(const py::array& a, const std::string& name, Inward inward) {
+    const char kind = a.dtype().kind();
+    py::array_t<float> out(a.size());
+    float* o = out.mutable_data();
+    const auto each = [&](const char* dtype, auto convert) {
+        const py::array r = required(a, dtype, name);
+        for (py::ssize_t i = 0; i < a.size(); ++i) o[i] = convert(i, r.data());
+    };
+    if (kind == 'f' && a.itemsize() == 4) {
+        each("float32", [](py::ssize_t i, const void* d) { return static_cast<const float*>(d)[i]; });
+    } else if (kind == 'f' && a.itemsize() <= 8) {
+        each("float64", [&](py::ssize_t i, const void* d) {
+            const double x = static_cast<const double*>(d)[i];
+            return std::isnan(x) ? static_cast<float>(x) : inner_float(x, inward);
+        });
+    } else if (kind == 'f') {
+        each("longdouble", [&](py::ssize_t i, const void* d) {
+            const long double x = static_cast<const long double*>(d)[i];
+            return std::isnan(x) ? static_cast<float>(x) : inner_float(x, inward);
+        });
+    } else if (kind == 'u') {
+        each("uint64", [&](py::ssize_t i, const void* d) {
+            return inner_float(static_cast<unsigned __int128>(static_cast<const std::uint64_t*>(d)[i]), inward);
+        });
+    } else {
+        each("int64", [&](py::ssize_t i, const void* d) {
+            return inner_float(static_cast<__int128>(static_cast<const std::int64_t*>(d)[i]), inward);
+        });
+    }
+    return out;
+}
+
+}  // namespace
+
+Bound ray_bound(py::handle object, const std::string& name, std::size_t rays, Inward inward) {
     const py::array a = as_array(object, name);
     check_real(a, name);
     Bound b;
     if (a.ndim() == 0) {
-        b.scalar = *static_cast<const float*>(required(a, "float32", name).data());
+        b.scalar = inner_floats(a, name, inward).data()[0];
         if (std::isnan(b.scalar)) throw py::value_error(name + " is NaN");
         return b;
     }
@@ -104,7 +173,13 @@ Bound ray_bound(py::handle object, const std::string& name, std::size_t rays) {
     if (static_cast<std::size_t>(a.shape(0)) != rays)
         throw py::value_error(name + " has " + std::to_string(a.shape(0)) + " values for " + std::to_string(rays) +
                               " rays");
-    b.values = rows_of(a, name, rays);
+    if (a.dtype().kind() == 'f' && a.itemsize() == 4) {
+        b.values = rows_of(a, name, rays);
+    } else {
+        b.values.array = inner_floats(a, name, inward);
+        b.values.data = static_cast<const float*>(b.values.array.data());
+        b.values.rows = rays;
+    }
     return b;
 }
 
@@ -129,7 +204,7 @@ std::vector<std::int64_t> object_face_indices(const py::array& f, std::size_t ve
                 try {
                     k = index(x);
                 } catch (py::error_already_set& e) {
-                    if (e.matches(PyExc_MemoryError)) throw;
+                    if (passes_through(e)) throw;
                 }
             }
             if (!k) throw py::value_error(at() + py::repr(x).cast<std::string>() + " is not an integer");
@@ -180,7 +255,6 @@ std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
 
 std::vector<Triangle> triangle_soup(py::handle triangles) {
     const FloatRows r = triangle_rows(triangles, "triangles");
-    check_triangle_count(r.rows, "triangles");
     std::vector<Triangle> tris(r.rows);
     for (std::size_t t = 0; t < r.rows; ++t)
         for (std::size_t c = 0; c < 3; ++c) {

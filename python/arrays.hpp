@@ -30,17 +30,26 @@ struct FloatRows {
 // are the caller's to check (the rays check theirs while they are traced, in one pass).
 FloatRows float_rows(py::handle object, const std::string& name, std::size_t columns);
 
-// The same for an (M, 3, 3) array of triangles.
+// The same in two steps, so that sizes can be compared before anything is copied: the argument as an
+// (N, columns) array of real numbers, then its float32 rows.
+py::array row_array(py::handle object, const std::string& name, std::size_t columns);
+FloatRows float_rows(const py::array& rows, const std::string& name);
+
+// The same for an (M, 3, 3) array of triangles, refused before it is copied where there are more than a
+// uint32 index can name.
 FloatRows triangle_rows(py::handle object, const std::string& name);
 
-// A ray bound (tnear, tfar): a scalar for every ray, or one float32 per ray. NaN is refused.
+// A ray bound (tnear, tfar): a scalar for every ray, or one float32 per ray. NaN is refused. A value
+// float32 cannot hold (float64, a large integer) is rounded inward, toward the other bound (`up` for
+// tnear, `down` for tfar), so that no hit outside the bounds given is reported.
+enum class Inward { up, down };
 struct Bound {
     FloatRows values;      // empty rows: the scalar
     float scalar = 0.f;
     bool per_ray() const { return values.data != nullptr; }
     float at(std::size_t i) const { return per_ray() ? values.data[i] : scalar; }
 };
-Bound ray_bound(py::handle object, const std::string& name, std::size_t rays);
+Bound ray_bound(py::handle object, const std::string& name, std::size_t rays, Inward inward);
 
 // Triangles from vertices (N, 3) and faces (M, 3) of integers, every index checked against N, every
 // used vertex checked finite.
@@ -66,6 +75,11 @@ unsigned small_count(py::handle object, const std::string& name, unsigned max, u
 // encode (a lone surrogate) and for a NUL. With `file_name`, lone surrogates become the bytes they
 // stand for, as os.fsencode makes them: a name the system gave in bytes that are not UTF-8.
 std::string text(py::handle object, const std::string& name, bool file_name = false);
+
+// Whether an error raised while an argument was read must reach the caller as it is, not as a
+// ValueError naming the argument: MemoryError, which says nothing of the argument, and what is not an
+// Exception (KeyboardInterrupt, SystemExit), which a caller's `except ValueError` would swallow.
+bool passes_through(const py::error_already_set& e);
 
 // The array's shape as Python prints it: "(5, 4)".
 std::string shape_of(const py::array& a);

@@ -94,14 +94,17 @@ std::size_t for_valid_chunks(const Team& team, const RayInput& in, Trace&& trace
 
 RayInput ray_input(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar) {
     RayInput in;
-    in.origins = float_rows(origins, "origins", 3);
-    in.directions = float_rows(directions, "directions", 3);
-    if (in.origins.rows != in.directions.rows)
-        throw py::value_error("origins has " + std::to_string(in.origins.rows) + " rays, directions " +
-                              std::to_string(in.directions.rows));
+    // Both counted before either is copied: a mismatch is named, where a copy of a huge view would
+    // first run out of memory.
+    const py::array o = row_array(origins, "origins", 3), d = row_array(directions, "directions", 3);
+    if (o.shape(0) != d.shape(0))
+        throw py::value_error("origins has " + std::to_string(o.shape(0)) + " rays, directions " +
+                              std::to_string(d.shape(0)));
+    in.origins = float_rows(o, "origins");
+    in.directions = float_rows(d, "directions");
     in.count = in.origins.rows;
-    in.tnear = ray_bound(tnear, "tnear", in.count);
-    in.tfar = ray_bound(tfar, "tfar", in.count);
+    in.tnear = ray_bound(tnear, "tnear", in.count, Inward::up);
+    in.tfar = ray_bound(tfar, "tfar", in.count, Inward::down);
     return in;
 }
 

@@ -214,8 +214,8 @@ std::pair<int, int> image_size(py::handle size) {
     const auto seq = py::reinterpret_borrow<py::sequence>(size);
     if (seq.size() != 2) refuse();
     const unsigned max = static_cast<unsigned>(kMaxImageSide);
-    const int w = static_cast<int>(small_count(seq[0], "size[0]", max));
-    const int h = static_cast<int>(small_count(seq[1], "size[1]", max));
+    const int w = static_cast<int>(small_count(seq[0], "size[0]", max, 1));
+    const int h = static_cast<int>(small_count(seq[1], "size[1]", max, 1));
     try {
         check_image_size(w, h);
     } catch (const Error& e) {
@@ -264,7 +264,8 @@ std::shared_ptr<Scene> load(py::handle path) {
     py::object p;
     try {
         p = py::module_::import("os").attr("fspath")(path);
-    } catch (py::error_already_set&) {
+    } catch (py::error_already_set& e) {
+        if (passes_through(e)) throw;
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
     }
     // A str path as the system names the file: the bytes of a name that is not UTF-8 (Linux allows
@@ -278,7 +279,8 @@ std::shared_ptr<Scene> load(py::handle path) {
 
 py::tuple camera_rays(const Camera& camera, py::handle width, py::handle height) {
     const auto max = static_cast<unsigned>(kMaxImageSide);
-    const int w = static_cast<int>(small_count(width, "width", max)), h = static_cast<int>(small_count(height, "height", max));
+    const int w = static_cast<int>(small_count(width, "width", max, 1));
+    const int h = static_cast<int>(small_count(height, "height", max, 1));
     const PinholeCamera pinhole(camera, w, h);
     const auto n = static_cast<py::ssize_t>(w) * h;
     py::array_t<float> org({n, py::ssize_t{3}}), dir({n, py::ssize_t{3}});

@@ -174,6 +174,72 @@ def test_infinite_bounds_and_degenerate_rays_are_valid(acc):
     assert acc.intersect(O, D, tnear=5.0, tfar=1.0)["prim"].tolist() == [-1] * 4
 
 
+def test_bounds_float32_cannot_hold_are_rounded_toward_the_other_bound(acc):
+    # The triangle lies at t = 1. A float64 1 - 1e-8 is 1.0f to nearest, which let the hit at t = 1
+    # through a tfar below it (found by review, 2026-12-07); each bound now rounds inward.
+    below, above = 1 - 1e-8, 1 + 1e-8
+    for kind in (lambda x: x, lambda x: np.full(4, x), lambda x: np.full(4, x, np.longdouble)):
+        assert acc.intersect(O, D, tfar=kind(below))["prim"].tolist() == [-1] * 4
+        assert acc.intersect(O, D, tnear=kind(above))["prim"].tolist() == [-1] * 4
+        assert not acc.occluded(O, D, tfar=kind(below)).any()
+        assert acc.intersect(O, D, tfar=kind(1.0), tnear=kind(1.0))["prim"].tolist() == [0] * 4
+    # Integers beyond float32's 24 bits: 2^25 + 1 lies between two floats; as tnear it rounds up.
+    far = cellrt.Accelerator(TRI + np.array([0, 0, -2.0**25], np.float32))
+    up = np.array([[0.2, 0.2, 0.0]], np.float32), np.array([[0.0, 0.0, -1.0]], np.float32)
+    assert far.intersect(*up, tnear=np.array([2**25 + 1], np.int64))["prim"].tolist() == [-1]
+    assert far.intersect(*up, tfar=np.array([2**25 - 1], np.int64))["prim"].tolist() == [-1]
+    assert far.intersect(*up, tnear=np.array([2**25], np.uint64))["prim"].tolist() == [0]
+    # Past float32's range a bound is the largest float on its side, not an infinity that changes it.
+    assert acc.intersect(O, D, tfar=1e300)["prim"].tolist() == [0] * 4
+    assert acc.intersect(O, D, tnear=1e300)["prim"].tolist() == [-1] * 4
+
+
+def test_masked_entries_are_refused_not_read(acc):
+    # numpy hands over a masked array's data under its mask too: the masked rays were traced, the masked
+    # faces built (found by review, 2026-12-07). A masked array without masked entries is an array.
+    masked = np.ma.array(O, mask=np.zeros_like(O, bool))
+    assert acc.intersect(masked, D)["prim"].tolist() == [0] * 4
+    masked[1] = np.ma.masked
+    refused(r"origins is a masked array with masked entries, whose values would be used; pass origins.filled",
+            acc.intersect, masked, D)
+    refused("tfar is a masked array with masked entries", acc.occluded, O, D, tfar=np.ma.masked)
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], np.float32)
+    refused("faces is a masked array with masked entries", cellrt.Accelerator, vertices,
+            np.ma.array([[0, 1, 2], [1, 3, 2]], mask=[[0, 0, 0], [1, 1, 1]]))
+
+
+def test_an_interrupt_while_an_argument_is_read_is_not_a_value_error(acc):
+    # Ctrl-C, or SystemExit, raised while numpy converts an argument (a long list, an __array__, an
+    # __index__, an __fspath__) was turned into "origins is not an array: " (found by review, 2026-12-07).
+    class Raises:
+        def __init__(self, error):
+            self.error = error
+
+        def __array__(self, *args):
+            raise self.error
+
+        __index__ = __fspath__ = __array__
+
+    with pytest.raises(KeyboardInterrupt):
+        acc.intersect(Raises(KeyboardInterrupt()), D)
+    with pytest.raises(SystemExit):
+        acc.occluded(O, Raises(SystemExit(3)))
+    with pytest.raises(KeyboardInterrupt):
+        cellrt.load_scene(Raises(KeyboardInterrupt()))
+    with pytest.raises(KeyboardInterrupt):
+        cellrt.Accelerator(TRI[0], np.array([[0, 1, Raises(KeyboardInterrupt())]], dtype=object))
+    refused("origins is not an array", acc.intersect, Raises(RuntimeError("no")), D)
+
+
+def test_sizes_are_checked_before_arguments_are_copied(acc):
+    # Views of one row repeated, which numpy would copy to float32 first: the copy ran out of memory
+    # before the mismatch or the count was named (found by review, 2026-12-07).
+    huge = np.lib.stride_tricks.as_strided(O[0].astype(np.float64), shape=(2**40, 3), strides=(0, 8))
+    refused("origins has 1099511627776 rays, directions 4", acc.intersect, huge, D)
+    soup = np.lib.stride_tricks.as_strided(TRI.astype(np.float64), shape=(2**32 - 1, 3, 3), strides=(0, 24, 8))
+    refused("triangles has 4294967295 triangles; at most 4294967294 are indexable", cellrt.Accelerator, soup)
+
+
 def test_bad_scene_files(tmp_path):
     with pytest.raises(cellrt.Error, match="no such file"):
         cellrt.load_scene(tmp_path / "missing.obj")
@@ -213,7 +279,8 @@ def test_bad_render_arguments(tmp_path):
     refused(r"size must be \(width, height\), got 64", cellrt.render, scene, size=64)
     refused(r"size must be \(width, height\), got '64x64'", cellrt.render, scene, size="64x64")
     refused(r"size\[0\] must be an integer", cellrt.render, scene, size=(-1, 5))
-    refused(r"size: image size 0x5", cellrt.render, scene, size=(0, 5))
+    # The range named is the one checked: 0 was refused as "image size 0x5" after "[0, 65536]".
+    refused(r"size\[0\] must be an integer in \[1, 65536\], got 0", cellrt.render, scene, size=(0, 5))
     refused(r"size: image size 65536x65536", cellrt.render, scene, size=(65536, 65536))
     refused(r"ao_samples must be an integer in \[1, 64\], got 0", cellrt.render, scene, shading="ao", ao_samples=0)
     refused(r"ao_samples must be an integer in \[1, 64\], got 65", cellrt.render, scene, shading="ao", ao_samples=65)
@@ -240,8 +307,7 @@ def test_bad_scene_properties():
     refused("triangles must hold at least one triangle", cellrt.Scene, np.zeros((0, 3, 3)))
     with pytest.raises(ValueError):
         scene.triangles[0, 0, 0] = 5.0
-    with pytest.raises(cellrt.Error, match="image size 0x4"):
-        scene.camera.rays(0, 4)
+    refused(r"width must be an integer in \[1, 65536\], got 0", scene.camera.rays, 0, 4)
 
 
 def test_a_missing_gpu_is_a_library_error_naming_why():
@@ -355,7 +421,7 @@ def test_numpy_scalars_count_as_what_they_hold():
                                                        "empty_bonus": np.float32(0.25)})
     assert acc.config == "kd+auto@empty_bonus=0.25,leaf_size=2,perfect_splits=false"
     refused(r"threads must be an integer in \[0, 1024\], got True", cellrt.Accelerator, TRI, threads=np.bool_(True))
-    refused(r"size\[0\] must be an integer in \[0, 65536\], got True", cellrt.render, cellrt.Scene(TRI),
+    refused(r"size\[0\] must be an integer in \[1, 65536\], got True", cellrt.render, cellrt.Scene(TRI),
             size=(np.bool_(True), 4))
     assert cellrt.render(cellrt.Scene(TRI), size=(np.int64(4), np.uint8(3))).shape == (3, 4, 3)
 
