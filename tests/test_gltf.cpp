@@ -220,6 +220,17 @@ TEST_F(GltfTest, ALargeMeshLoadsWithItsOwnCamera) {
     doc["scenes"][0]["nodes"] = {0, 1};
     const Scene s = load_scene(embedded(doc));
     EXPECT_EQ(s.camera.position, (Vec3{0.f, 0.f, 5.f}));
+    // Larger still, the default light cannot be placed: the message names the light, not a view the
+    // file does not use (found by review, 2026-12-07).
+    doc["nodes"][0]["scale"] = {1e38, 1e38, 1e38};
+    try {
+        load_scene(embedded(doc));
+        ADD_FAILURE() << "a mesh the default light cannot be placed for was loaded";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("for which the default light cannot be placed in float arithmetic"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 TEST_F(GltfTest, BadFilesAreRefusedNamingThePartAtFault) {

@@ -55,7 +55,10 @@ std::string default_view_problem(const Scene& scene, bool camera_too) {
     char span[160];
     std::snprintf(span, sizeof span, "(%.9g, %.9g, %.9g) to (%.9g, %.9g, %.9g)", b.lo.x, b.lo.y, b.lo.z, b.hi.x,
                   b.hi.y, b.hi.z);
-    return std::string("the mesh spans ") + span + ", which the default view cannot frame in float arithmetic";
+    // With a camera of its own (a glTF file's), only the default light was placed.
+    return std::string("the mesh spans ") + span +
+           (camera_too ? ", which the default view cannot frame in float arithmetic"
+                       : ", for which the default light cannot be placed in float arithmetic");
 }
 
 void validate_scene(const Scene& scene, const std::string& where) {
