@@ -116,10 +116,15 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
     }
     // A structure whose traversals are single-ray kernels runs its SIMD packets instead: asked for
     // together, the traversal would be dropped without a word (the BVH's take an instruction set).
-    if (!config.traversal.empty() && accel->stats().traversal != config.traversal)
-        throw Error((options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'") +
-                    " names a single-ray kernel, which the SIMD packets of " + options.simd_source() +
+    if (!config.traversal.empty() && accel->stats().traversal != config.traversal) {
+        const std::string kernel =
+            options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'";
+        if (kernel == options.simd_source())
+            throw Error(kernel + " names a single-ray kernel ('" + config.traversal + "') and SIMD packets ('" +
+                        config.simd + "'), which would replace it: leave one of them out");
+        throw Error(kernel + " names a single-ray kernel, which the SIMD packets of " + options.simd_source() +
                     " replace: leave one of them out");
+    }
     return accel;
 }
 

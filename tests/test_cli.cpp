@@ -276,8 +276,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
          "--traversal 'rec' names a single-ray kernel, which the SIMD packets of --simd replace: leave one of them "
          "out"},
         {{"info", spheres, "--accel", "bih:branched+auto"},
-         "--accel 'bih:branched+auto' names a single-ray kernel, which the SIMD packets of --accel "
-         "'bih:branched+auto' replace: leave one of them out"},
+         "--accel 'bih:branched+auto' names a single-ray kernel ('branched') and SIMD packets ('auto'), which would "
+         "replace it: leave one of them out"},
         {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
         {{"info", dir.path.string()}, dir.path.string() + ": is a folder, not a file"},  // no extension
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
