@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <unistd.h>
 
+#include "localstore/local_store.hpp"
 #include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
@@ -131,6 +132,18 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
 void check_threads(unsigned threads) {
     if (threads > kMaxWorkers)
         throw Error("--threads " + std::to_string(threads) + " must lie in [0, " + std::to_string(kMaxWorkers) + "]");
+}
+
+void check_packet_fits(int packet, std::size_t budget_bytes, const std::string& remedy) {
+    const std::size_t rays = static_cast<std::size_t>(packet) * static_cast<std::size_t>(packet);
+    const std::size_t most = max_batch_rays(budget_bytes);
+    if (rays <= most) return;
+    std::size_t edge = 0;
+    while ((edge + 1) * (edge + 1) <= most) ++edge;
+    throw Error("--packet " + std::to_string(packet) + ": a packet's " + std::to_string(rays) +
+                " rays and their results do not fit the local store's " + std::to_string(budget_bytes) +
+                " bytes (a batch alone fits up to --packet " + std::to_string(edge) +
+                ", and the caches and the stack need room besides" + remedy + ")");
 }
 
 std::string json_report(const nlohmann::json& report) {

@@ -72,6 +72,11 @@ CLI::Validator non_empty();
 // Refuses a --threads of more than the library's kMaxWorkers.
 void check_threads(unsigned threads);
 
+// Refuses a --packet whose P x P rays and their results do not fit a local store of `budget_bytes`
+// (the library would refuse the batch after the scene is loaded, without naming the option), saying
+// the largest that fits; `remedy` is appended to that, as "; --local-store-kib raises the budget".
+void check_packet_fits(int packet, std::size_t budget_bytes, const std::string& remedy);
+
 // A JSON report as written to a file: indented, ending in a newline, any byte that is not UTF-8 (of a
 // file name, say) replaced by U+FFFD rather than failing once the work is done.
 std::string json_report(const nlohmann::json& report);

@@ -282,11 +282,15 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
         if (layout(i) == study) at_study = i;
     }
     auto cell = [&](std::size_t i) {
-        const LocalStoreStats& s = results[i].stats;
+        const CacheStats& c = node ? results[i].stats.node_cache : results[i].stats.triangle_cache;
         char buf[96];
-        std::snprintf(buf, sizeof buf, results[i].kernel_seconds > 0.0 ? "%s: %.1f %%, %.2f" : "%s: %.1f %%, %.0f",
-                      layout(i).to_string().c_str(), 100.0 * (node ? s.node_cache : s.triangle_cache).hit_ratio(),
-                      per_ray(i));
+        // A sample whose rays never read the swept cache (a corner packet of empty space) has no
+        // hit ratio: 0 % would read as the worst.
+        if (c.hits + c.misses == 0)
+            std::snprintf(buf, sizeof buf, "%s: no reads", layout(i).to_string().c_str());
+        else
+            std::snprintf(buf, sizeof buf, results[i].kernel_seconds > 0.0 ? "%s: %.1f %%, %.2f" : "%s: %.1f %%, %.0f",
+                          layout(i).to_string().c_str(), 100.0 * c.hit_ratio(), per_ray(i));
         return std::string(buf);
     };
     char buf[512];
@@ -368,6 +372,8 @@ Runner add_cache_study(CLI::App& app) {
             if (o->packet < 1 || o->packet > kMaxPacket)
                 throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " +
                             std::to_string(kMaxPacket) + "]");
+            if (o->device == "cpu") check_packet_fits(o->packet, LocalStoreConfig{}.budget_bytes, "");
+            cluster::check_no_repeats("scenes", o->scenes);
             check_threads(o->threads);
             csv_path = (std::filesystem::path(o->out) / "cache_study.csv").string();
             md_path = (std::filesystem::path(o->out) / "best_layouts.md").string();
@@ -394,14 +400,6 @@ Runner add_cache_study(CLI::App& app) {
             std::vector<Run> runs;
             cluster::together([&] {
                 if (!o->size.empty()) std::tie(width, height) = parse_image_size("--size", o->size);
-                w = sampled_frame(scene, width, height, o->packet, o->sample);
-                if (cluster::leader())
-                    std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): "
-                                "%zu primary + %zu shadow rays of the frame's %llu\n",
-                                scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
-                                PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample,
-                                w.primary.size(), w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
-                std::fflush(stdout);
                 for (const std::string& structure : o->structures) {
                     AccelConfig ac;
                     ac.kind = structure;
@@ -419,6 +417,27 @@ Runner add_cache_study(CLI::App& app) {
                                     runs.push_back(run);
                                 }
                 }
+                // Every run's local store checked before the frame is traced: a --packet whose batch
+                // leaves no room for the largest swept cache fails here, not after the tracing.
+                if (!gpu)
+                    for (const Run& run : runs) {
+                        std::size_t stack = 0;
+                        for (const LocalStoreAllocation& a : bases.at(run.structure)->local_store_allocations())
+                            if (a.what == kStackAllocation) stack = a.bytes;
+                        try {
+                            allocate_local_store(run.config, stack);
+                        } catch (const Error& e) {
+                            throw Error("--packet " + std::to_string(o->packet) + ": " + e.what());
+                        }
+                    }
+                w = sampled_frame(scene, width, height, o->packet, o->sample);
+                if (cluster::leader())
+                    std::printf("%s: %zu triangles, %dx%d; %zu of %zu packets of %dx%d (column + row a multiple of %d): "
+                                "%zu primary + %zu shadow rays of the frame's %llu\n",
+                                scene.name.c_str(), scene.triangles.size(), width, height, w.packets.size(),
+                                PacketGrid(width, height, o->packet).count(), o->packet, o->packet, o->sample,
+                                w.primary.size(), w.secondary.size(), static_cast<unsigned long long>(w.frame_ray_count));
+                std::fflush(stdout);
             }, "building the structures");
             Timer timer;
             const std::vector<Result> results = gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);

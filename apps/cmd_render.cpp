@@ -61,6 +61,7 @@ struct LocalStoreOptions {
         if (kib < 16 || kib > 16384)
             throw Error("--local-store-kib " + std::to_string(kib) + " must lie in [16, 16384]");
         c.budget_bytes = static_cast<std::size_t>(kib) * 1024;
+        check_packet_fits(packet, c.budget_bytes, "; --local-store-kib raises the budget");
         c.batch_rays = static_cast<std::size_t>(packet) * packet;
         return c;
     }
@@ -235,7 +236,7 @@ Runner add_render(CLI::App& app) {
             if (o->local_store.enabled) {
                 // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
                 AccelConfig config = o->accel.config();
-                if (o->accel.simd_option->count() == 0) config.simd = "off";
+                if (o->accel.simd_option->count() == 0 && !o->accel.simd_named()) config.simd = "off";
                 modelled = make_local_store_accelerator(scene.triangles, config, local_store);
             } else {
                 direct = build_structure(scene.triangles, o->accel.config(), o->accel);

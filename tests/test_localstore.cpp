@@ -546,6 +546,9 @@ TEST(LocalStoreCli, RefusesBadOptionsNamingThem) {
              {"--local-store --local-store-kib 8", "--local-store-kib 8"},
              {"--local-store --node-cache 4096x64", "more than the budget"},
              {"--local-store --simd avx2", "not SIMD packets"},
+             // A SIMD set named in --accel was dropped without a word (found by review, 2026-12-07).
+             {"--local-store --accel kd+avx2", "not SIMD packets"},
+             {"--local-store --packet 128", "--packet 128: a packet's 16384 rays and their results do not fit"},
              {"--local-store --accel brute", "runs the trees (kd, bih), not 'brute'"},
              {"--local-store -P leaf_size=-3", "leaf_size=-3"},
          }) {
@@ -583,6 +586,34 @@ TEST(LocalStoreCli, CacheStudyWritesEveryRun) {
     EXPECT_NE(run_cli(dir.path, "cache-study 'builtin:spheres?tris=500' --structures octree -o " + dir.path.string())
                   .status,
               0);
+}
+
+// Found by review (2026-12-07): a packet too large for the local store failed after the frame was
+// traced, without naming --packet; a scene named twice wrote its rows twice; and a sample whose rays
+// read no cache line (a corner packet of empty space) listed its first layout as the best at 0 %.
+TEST(LocalStoreCli, CacheStudyRefusesEarlyAndSaysWhenASweepReadNothing) {
+    TempDir dir;
+    const std::string out = " -o " + (dir.path / "study").string();
+    CliRun run = run_cli(dir.path, "cache-study 'builtin:spheres?tris=500' --packet 70" + out);
+    EXPECT_EQ(run.status, 1);
+    EXPECT_NE(run.output.find("cellrt: error: --packet 70: local store: the configuration needs"), std::string::npos)
+        << run.output;
+    EXPECT_EQ(run.output.find("triangles,"), std::string::npos) << "refused before the frame is traced: " << run.output;
+    run = run_cli(dir.path, "cache-study 'builtin:spheres?tris=500' 'builtin:spheres?tris=500'" + out);
+    EXPECT_NE(run.output.find("names 'builtin:spheres?tris=500' twice"), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.path / "study"));
+    {
+        std::ofstream obj(dir.path / "one.obj");
+        obj << "v -0.1 -0.1 0\nv 0.1 -0.1 0\nv 0 0.1 0\nf 1 2 3\n";
+    }
+    run = run_cli(dir.path, "cache-study " + (dir.path / "one.obj").string() +
+                                " --size 64x64 --structures kd --traversals branched --access sync" + out);
+    ASSERT_EQ(run.status, 0) << run.output;
+    std::ifstream md(dir.path / "study" / "best_layouts.md");
+    const std::string table((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+    EXPECT_NE(table.find("| one | kd | branched | sync | triangles | 16x4: no reads | 16x4: no reads | 1024x16: no reads |"),
+              std::string::npos)
+        << table;
 }
 
 }  // namespace

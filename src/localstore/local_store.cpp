@@ -13,6 +13,8 @@ CacheAccess parse_cache_access(const std::string& option, const std::string& tex
 
 const char* to_string(CacheAccess access) { return access == CacheAccess::sync ? "sync" : "async"; }
 
+std::size_t max_batch_rays(std::size_t budget_bytes) { return budget_bytes / (sizeof(Ray) + sizeof(Hit)); }
+
 std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& config, std::size_t stack_bytes) {
     validate_cache_layout(config.node_cache, "node cache " + config.node_cache.to_string());
     validate_cache_layout(config.triangle_cache, "triangle cache " + config.triangle_cache.to_string());
@@ -21,7 +23,7 @@ std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& c
     if (config.budget_bytes > kMaxLocalStoreBytes)
         throw Error("local store: a budget of " + std::to_string(config.budget_bytes) + " bytes is more than the " +
                     "model's " + std::to_string(kMaxLocalStoreBytes));
-    if (config.batch_rays > config.budget_bytes / (sizeof(Ray) + sizeof(Hit)))
+    if (config.batch_rays > max_batch_rays(config.budget_bytes))
         throw Error("local store: a batch of " + std::to_string(config.batch_rays) + " rays and results needs more " +
                     "than the budget of " + std::to_string(config.budget_bytes) + " bytes");
     auto cache = [](const char* name, const CacheLayout& l) {
@@ -31,7 +33,7 @@ std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& c
     const std::vector<LocalStoreAllocation> allocations = {
         cache("node cache", config.node_cache),
         cache("triangle cache", config.triangle_cache),
-        {"traversal stack", stack_bytes},
+        {kStackAllocation, stack_bytes},
         {"batch of " + std::to_string(config.batch_rays) + " rays and results",
          config.batch_rays * (sizeof(Ray) + sizeof(Hit))},
     };

@@ -52,6 +52,13 @@ struct LocalStoreAllocation {
 // The largest budget the model takes: 4 GiB - 1, as its transfers count bytes in 32 bits.
 inline constexpr std::size_t kMaxLocalStoreBytes = 0xffff'ffff;
 
+// The name of the traversal stack's allocation, as allocate_local_store lists it.
+inline constexpr const char* kStackAllocation = "traversal stack";
+
+// The most rays a batch may hold in a local store of `budget_bytes`, each with its result, before
+// anything else is allocated.
+std::size_t max_batch_rays(std::size_t budget_bytes);
+
 // The allocations of `config` with a traversal stack of `stack_bytes`. Throws cellrt::Error when a
 // layout is invalid, the budget is over kMaxLocalStoreBytes or the allocations exceed it, saying by
 // how many bytes.
