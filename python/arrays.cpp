@@ -15,13 +15,18 @@ py::module_ numpy() { return py::module_::import("numpy"); }
 std::string message_of(const py::error_already_set& e) { return py::str(e.value()).cast<std::string>(); }
 
 py::array as_array(py::handle object, const std::string& name) {
-    // numpy reads a masked array's data under its mask too: the entries the caller masked out would be
-    // traced or built as if they were not.
-    const py::object ma = numpy().attr("ma");
-    if (py::isinstance(object, ma.attr("MaskedArray")) && ma.attr("is_masked")(object).cast<bool>())
-        throw py::value_error(name + " is a masked array with masked entries, whose values would be used; pass " +
-                              name + ".filled(...) or only the rows to use");
-    if (py::isinstance<py::array>(object)) return py::reinterpret_borrow<py::array>(object);
+    if (py::isinstance<py::array>(object)) {
+        // numpy reads a masked array's data under its mask too: the entries the caller masked out
+        // would be traced or built as if they were not. Asked of ndarray's subclasses only, so that a
+        // plain array costs one compare.
+        if (Py_TYPE(object.ptr()) != py::detail::npy_api::get().PyArray_Type_) {
+            const py::object ma = numpy().attr("ma");
+            if (py::isinstance(object, ma.attr("MaskedArray")) && ma.attr("is_masked")(object).cast<bool>())
+                throw py::value_error(name + " is a masked array with masked entries, whose values would be used; " +
+                                      "pass " + name + ".filled(...) or only the rows to use");
+        }
+        return py::reinterpret_borrow<py::array>(object);
+    }
     try {
         return numpy().attr("asarray")(object);
     } catch (py::error_already_set& e) {
@@ -218,11 +223,8 @@ std::vector<std::int64_t> object_face_indices(const py::array& f, std::size_t ve
 }
 
 std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
-    const FloatRows v = float_rows(vertices, "vertices", 3);
-    for (std::size_t i = 0; i < v.rows; ++i)
-        if (!finite3(v.data + 3 * i))
-            throw py::value_error("vertices[" + std::to_string(i) + "] = " + vec_text(v.data + 3 * i) +
-                                  " is not finite");
+    // Both arguments' shapes and kinds before either is copied.
+    const py::array va = row_array(vertices, "vertices", 3);
     const py::array f = as_array(faces, "faces");
     if (f.ndim() != 2 || f.shape(1) != 3)
         throw py::value_error("faces must have shape (M, 3), got " + shape_of(f));
@@ -231,6 +233,11 @@ std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
         throw py::value_error("faces must hold integers, got dtype " + dtype_of(f));
     const std::size_t m = static_cast<std::size_t>(f.shape(0));
     check_triangle_count(m, "faces");
+    const FloatRows v = float_rows(va, "vertices");
+    for (std::size_t i = 0; i < v.rows; ++i)
+        if (!finite3(v.data + 3 * i))
+            throw py::value_error("vertices[" + std::to_string(i) + "] = " + vec_text(v.data + 3 * i) +
+                                  " is not finite");
     // uint64 indices beyond int64 wrap to negative values, which the range check refuses.
     std::vector<std::int64_t> objects;
     py::array idx;
@@ -276,10 +283,26 @@ Vec3 vec3_value(py::handle object, const std::string& name) {
     return Vec3{p[0], p[1], p[2]};
 }
 
+namespace {
+
+// object.name, or None where it has no such attribute; any other error raised (Ctrl-C in a property)
+// reaches the caller, where py::hasattr would swallow it.
+py::object attribute_or_none(py::handle object, const char* name) {
+    PyObject* value = PyObject_GetAttrString(object.ptr(), name);
+    if (value) return py::reinterpret_steal<py::object>(value);
+    if (!PyErr_ExceptionMatches(PyExc_AttributeError)) throw py::error_already_set();
+    PyErr_Clear();
+    return py::none();
+}
+
+}  // namespace
+
 bool is_numpy_kind(py::handle object, char kind) {
-    if (py::isinstance<py::array>(object) || !py::hasattr(object, "dtype")) return false;
-    const py::object dtype = object.attr("dtype");
-    return py::hasattr(dtype, "kind") && py::str(dtype.attr("kind")).cast<std::string>() == std::string(1, kind);
+    if (py::isinstance<py::array>(object)) return false;
+    const py::object dtype = attribute_or_none(object, "dtype");
+    if (dtype.is_none()) return false;
+    const py::object k = attribute_or_none(dtype, "kind");
+    return !k.is_none() && py::str(k).cast<std::string>() == std::string(1, kind);
 }
 
 bool is_bool(py::handle object) { return py::isinstance<py::bool_>(object) || is_numpy_kind(object, 'b'); }

@@ -94,17 +94,17 @@ std::size_t for_valid_chunks(const Team& team, const RayInput& in, Trace&& trace
 
 RayInput ray_input(py::handle origins, py::handle directions, py::handle tnear, py::handle tfar) {
     RayInput in;
-    // Both counted before either is copied: a mismatch is named, where a copy of a huge view would
-    // first run out of memory.
+    // Every length compared before the rays are copied: a mismatch is named, where a copy of a huge
+    // view would first run out of memory.
     const py::array o = row_array(origins, "origins", 3), d = row_array(directions, "directions", 3);
     if (o.shape(0) != d.shape(0))
         throw py::value_error("origins has " + std::to_string(o.shape(0)) + " rays, directions " +
                               std::to_string(d.shape(0)));
-    in.origins = float_rows(o, "origins");
-    in.directions = float_rows(d, "directions");
-    in.count = in.origins.rows;
+    in.count = static_cast<std::size_t>(o.shape(0));
     in.tnear = ray_bound(tnear, "tnear", in.count, Inward::up);
     in.tfar = ray_bound(tfar, "tfar", in.count, Inward::down);
+    in.origins = float_rows(o, "origins");
+    in.directions = float_rows(d, "directions");
     return in;
 }
 

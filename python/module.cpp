@@ -405,7 +405,8 @@ PYBIND11_MODULE(cellrt, m) {
                                 refuse();
                             const double d = PyFloat_AsDouble(value.ptr());
                             if (d == -1.0 && PyErr_Occurred()) {
-                                PyErr_Clear();
+                                py::error_already_set e;
+                                if (passes_through(e)) throw e;
                                 refuse();
                             }
                             const float f = static_cast<float>(d);

@@ -230,12 +230,30 @@ def test_an_interrupt_while_an_argument_is_read_is_not_a_value_error(acc):
         cellrt.Accelerator(TRI[0], np.array([[0, 1, Raises(KeyboardInterrupt())]], dtype=object))
     refused("origins is not an array", acc.intersect, Raises(RuntimeError("no")), D)
 
+    class Number:  # a number whose conversion is interrupted, or whose dtype property is
+        def __float__(self):
+            raise KeyboardInterrupt
+
+        @property
+        def dtype(self):
+            raise KeyboardInterrupt
+
+        def __index__(self):
+            return 2
+
+    with pytest.raises(KeyboardInterrupt):
+        cellrt.Camera().fov_y_deg = Number()
+    with pytest.raises(KeyboardInterrupt):
+        cellrt.Accelerator(TRI, threads=Number())
+
 
 def test_sizes_are_checked_before_arguments_are_copied(acc):
     # Views of one row repeated, which numpy would copy to float32 first: the copy ran out of memory
     # before the mismatch or the count was named (found by review, 2026-12-07).
     huge = np.lib.stride_tricks.as_strided(O[0].astype(np.float64), shape=(2**40, 3), strides=(0, 8))
     refused("origins has 1099511627776 rays, directions 4", acc.intersect, huge, D)
+    refused("tfar has 4 values for 1099511627776 rays", acc.intersect, huge, huge, tfar=np.ones(4))
+    refused(r"faces must have shape \(M, 3\), got \(4, 2\)", cellrt.Accelerator, huge, np.zeros((4, 2), np.int64))
     soup = np.lib.stride_tricks.as_strided(TRI.astype(np.float64), shape=(2**32 - 1, 3, 3), strides=(0, 24, 8))
     refused("triangles has 4294967295 triangles; at most 4294967294 are indexable", cellrt.Accelerator, soup)
 
