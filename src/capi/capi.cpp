@@ -19,8 +19,10 @@
 namespace cellrt::capi {
 namespace {
 
+// Never destroyed: a C program's atexit handler, registered before its first cellrt call, runs after
+// the statics made since are gone, and may still release its handles (as may threads running at exit).
 HandleTable& table() {
-    static HandleTable t;
+    static HandleTable& t = *new HandleTable;
     return t;
 }
 
@@ -38,10 +40,36 @@ struct Record {
 };
 
 // The calling thread's latest error per device id (0: errors with no device). Ids are never reused,
-// so a record never outlives its meaning.
-std::unordered_map<std::uint64_t, Record>& records() {
-    thread_local std::unordered_map<std::uint64_t, Record> r;
-    return r;
+// so a record never outlives its meaning. A record that was read, of a device released since, says
+// nothing get_error would not say without it: such records are dropped whenever the map has doubled
+// since the last sweep, so that a program making a device per job does not grow without bound.
+struct Records {
+    std::unordered_map<std::uint64_t, Record> map;
+    std::size_t sweep_at = 64;
+    ~Records();
+};
+// Trivially destructible, so readable after the thread's records are gone (an atexit handler's call
+// on the main thread comes after them): errors are then returned but not recorded.
+thread_local bool t_records_gone = false;
+Records::~Records() { t_records_gone = true; }
+
+Records* records() {
+    if (t_records_gone) return nullptr;
+    thread_local Records r;
+    return &r;
+}
+
+void record(std::uint64_t device, cellrt_error code, const char* message) {
+    Records* all = records();
+    if (!all) return;
+    Record& r = all->map[device];
+    r.code = code;
+    r.message = message;
+    if (all->map.size() < all->sweep_at) return;
+    std::erase_if(all->map, [](const auto& entry) {
+        return entry.first != 0 && entry.second.code == CELLRT_SUCCESS && !table().find<Device>(entry.first);
+    });
+    all->sweep_at = std::max<std::size_t>(64, 2 * all->map.size());
 }
 
 template <class Handle>
@@ -51,9 +79,7 @@ Handle handle_of(std::uint64_t id) { return reinterpret_cast<Handle>(static_cast
 
 cellrt_error report(const std::shared_ptr<Device>& device, cellrt_error code, const char* message) noexcept {
     try {
-        Record& r = records()[device ? device->id : 0];
-        r.code = code;
-        r.message = message;
+        record(device ? device->id : 0, code, message);
     } catch (...) {  // no memory for the record: the code is still returned
     }
     if (device) {
@@ -261,9 +287,9 @@ cellrt_error cellrt_device_get_error(cellrt_device device, const char** message)
     // Records are kept by id, so a handle that was never live has none, and one released keeps the
     // calling thread's last error recorded on it while it lived (a release too many is recorded
     // under NULL: a dead handle has no device).
-    auto& all = records();
-    const auto it = all.find(id_of(device));
-    if (it == all.end()) {
+    Records* all = records();
+    const auto it = all ? all->map.find(id_of(device)) : decltype(all->map)::iterator{};
+    if (!all || it == all->map.end()) {
         if (message) *message = "";
         return CELLRT_SUCCESS;
     }
