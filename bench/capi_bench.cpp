@@ -27,9 +27,9 @@ double seconds(F&& f) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
+constexpr const char* kUsage = "usage: cellrt_capi_bench [SCENE [CONFIG...]]   (default: builtin:city kd+auto bvh)";
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     const std::string spec = argc > 1 ? argv[1] : "builtin:city";
     std::vector<std::string> configs(argv + std::min(argc, 2), argv + argc);
     if (configs.empty()) configs = {"kd+auto", "bvh"};
@@ -78,4 +78,21 @@ int main(int argc, char** argv) {
     cellrt_scene_release(c_scene);
     cellrt_device_release(device);
     return status;
+}
+
+}  // namespace
+
+// A bad scene or configuration is one line and status 1, as in the other programs (it ended in
+// std::terminate: found by review, 2026-12-07).
+int main(int argc, char** argv) {
+    if (argc > 1 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
+        std::puts(kUsage);
+        return 0;
+    }
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "cellrt_capi_bench: error: %s\n%s\n", e.what(), kUsage);
+        return 1;
+    }
 }

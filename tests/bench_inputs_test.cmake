@@ -1,6 +1,6 @@
 # The benchmark programs' bad inputs and outputs: each refused before any run with one line naming the
 # option, status 1, and no file the user has replaced. Arguments: BENCH (cellrt_bench), SCALING
-# (cellrt_scaling), WORK (a scratch folder).
+# (cellrt_scaling), CAPI (cellrt_capi_bench), WORK (a scratch folder).
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(mine "the user's own file\n")
@@ -47,8 +47,17 @@ expect("--workers 0 must lie in [1, 1024]" ${SCALING} ${small} --configs kd --wo
 expect("--workers names '2' twice" ${SCALING} ${small} --configs kd --workers 2 1 2)
 expect("--csv ${WORK}/x.json names the same file as --json ${WORK}/x.json"
        ${SCALING} ${small} --configs kd --workers 1 --json ${WORK}/x.json --csv ${WORK}/x.json)
+# Through a link whose file the run would write first (it was found only after the sweep; 2026-12-07).
+file(CREATE_LINK x.json ${WORK}/link.csv SYMBOLIC)
+expect("--csv ${WORK}/link.csv names the same file as --json ${WORK}/x.json"
+       ${SCALING} ${small} --configs kd --workers 1 --json ${WORK}/x.json --csv ${WORK}/link.csv)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${SCALING} ${small} --configs kd --workers 1 --csv ${WORK}/mine.json)
+# cellrt_capi_bench: one line and status 1 (a bad scene ended in std::terminate; 2026-12-07).
+execute_process(COMMAND ${CAPI} ${WORK}/missing.obj OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "^cellrt_capi_bench: error: ${WORK}/missing.obj: no such file\n")
+  message(FATAL_ERROR "cellrt_capi_bench missing.obj: status ${rc}, printed '${err}'")
+endif()
 file(READ ${WORK}/mine.json kept)
 if(NOT kept STREQUAL "${mine}" OR EXISTS ${WORK}/x.json)
   message(FATAL_ERROR "a refused run wrote a file: mine.json now '${kept}'")

@@ -92,6 +92,13 @@ string(FIND "${table}" "| city |" at)
 if(NOT rc EQUAL 0 OR at EQUAL -1)
   message(FATAL_ERROR "bench/scaling_tables.py failed (${rc}): ${log}${table}")
 endif()
+# A table per dispatch mode: keyed without it, the last mode's figures stood for both (2026-12-07).
+foreach(mode pull mailbox)
+  string(FIND "${table}" "${mode} dispatch," at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "bench/scaling_tables.py has no table of ${mode} dispatch: ${table}")
+  endif()
+endforeach()
 execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/plot_scaling.py ${WORK}/scaling.json ${WORK}/plots
                 ERROR_VARIABLE log RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/plots/scaling_city.png)

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <future>
 #include <sys/stat.h>
 #include <sys/mman.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -141,6 +143,13 @@ TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     write_image(img, link, true);
     EXPECT_TRUE(std::filesystem::is_symlink(link));
     EXPECT_TRUE(same_bits(read_pfm(file), img));
+    // A link whose file is not there yet is written through, as a shell's `>` does (the rename used
+    // to replace the link by the file; 2026-12-07).
+    const std::string ahead = (dir / "ahead.pfm").string();
+    std::filesystem::create_symlink("later.pfm", ahead);
+    write_image(img, ahead, false);
+    EXPECT_TRUE(std::filesystem::is_symlink(ahead));
+    EXPECT_TRUE(same_bits(read_pfm((dir / "later.pfm").string()), img));
     const std::string folder = (dir / "folder.pfm").string();
     std::filesystem::create_directories(folder);
     EXPECT_EQ(test::error_of([&] { write_image(img, folder, true); }), folder + ": is a folder, not a file");
@@ -158,6 +167,38 @@ TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     std::ifstream logged(log);
     EXPECT_EQ((std::string{std::istreambuf_iterator<char>(logged), std::istreambuf_iterator<char>()}), "first\nsecond\n");
     std::filesystem::remove_all(dir);
+}
+
+// Found by review (2026-12-07): `cellrt_scaling --json /dev/stdout > log` lost the results: a second
+// descriptor of the redirected file wrote them at offset 0, and the tables the program had buffered
+// were then flushed over them. Bytes for the process's own standard output go through its stream.
+TEST(Render, TheProcesssOwnStandardOutputIsWrittenThroughItsStream) {
+    const std::string log =
+        (std::filesystem::temp_directory_path() / ("cellrt_stdout_" + std::to_string(::getpid()) + ".txt")).string();
+    std::fflush(stdout);  // the child must not write the parent's buffered output too
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+        if (fd < 0 || ::dup2(fd, STDOUT_FILENO) < 0) ::_exit(2);
+        std::printf("table\n");  // held in stdout's buffer: it is a file now
+        try {
+            write_file_atomically("/dev/stdout", "results\n", false);
+        } catch (...) {
+            ::_exit(3);
+        }
+        std::printf("after\n");
+        std::fflush(stdout);
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << status;
+    EXPECT_EQ(WEXITSTATUS(status), 0);
+    std::ifstream written(log);
+    EXPECT_EQ((std::string{std::istreambuf_iterator<char>(written), std::istreambuf_iterator<char>()}),
+              "table\nresults\nafter\n");
+    std::filesystem::remove(log);
 }
 
 // read_pfm reads only a regular file, as the loaders do: a folder or a named pipe in the image's place

@@ -4,9 +4,13 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cellrt/error.hpp"
@@ -32,18 +36,47 @@ Target target_of(const std::string& path) {
     return fs::is_regular_file(st) && !system ? Target::file : Target::stream;
 }
 
-// A path as the file it names: links and dots resolved where the system can, else as written. For an
-// existing file, its folder takes the temporary file and the rename replaces the file, not the link.
+// A path as the file it names: links and dots resolved where the system can, else as written. Its
+// folder takes the temporary file, and the rename replaces the file, not a link to it. A link whose
+// file is not there yet is followed too (as a shell's `>` follows it): it names that file, the one a
+// write makes and another output may name directly.
 fs::path file_named(const std::string& path) {
     std::error_code ec;
-    const fs::path p = fs::weakly_canonical(path, ec);
-    return ec ? fs::absolute(path, ec).lexically_normal() : p;
+    fs::path p = fs::absolute(path, ec);
+    if (ec) p = path;
+    for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+        const fs::path to = fs::read_symlink(p, ec);
+        if (ec) break;
+        p = to.is_absolute() ? to : p.parent_path() / to;
+    }
+    const fs::path resolved = fs::weakly_canonical(p, ec);
+    return ec ? p.lexically_normal() : resolved;
 }
 
 fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
 
+// The process's own standard output or error when `path` leads to the same file, else null. Their
+// bytes go through that stream, after what it holds buffered: a second descriptor of a redirected
+// file (`--json /dev/stdout > log`) would write at an offset of its own, and the program's tables,
+// flushed later at stdout's, would overwrite the results.
+std::FILE* own_stream(const std::string& path) {
+    struct stat named {};
+    if (::stat(path.c_str(), &named) != 0) return nullptr;
+    for (const auto& [fd, stream] : {std::pair{STDOUT_FILENO, stdout}, std::pair{STDERR_FILENO, stderr}}) {
+        struct stat st {};
+        if (::fstat(fd, &st) == 0 && st.st_dev == named.st_dev && st.st_ino == named.st_ino) return stream;
+    }
+    return nullptr;
+}
+
 // Appended, so that a stream that leads to a file (a shell's `> log`) is not truncated.
 void write_in_place(const std::string& path, std::string_view bytes) {
+    if (std::FILE* stream = own_stream(path)) {
+        if (std::fflush(stream) != 0 || std::fwrite(bytes.data(), 1, bytes.size(), stream) != bytes.size() ||
+            std::fflush(stream) != 0)
+            throw Error(path + ": write failed");
+        return;
+    }
     std::ofstream out(path, std::ios::binary | std::ios::app);
     if (!out) throw Error(path + ": cannot be opened for writing");
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -64,7 +97,7 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
     if (kind == Target::stream) return write_in_place(path, bytes);
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists and overwrite is off");
-    const fs::path target = kind == Target::file ? file_named(path) : fs::path(path);
+    const fs::path target = file_named(path);
     const fs::path dir = folder_of(target);
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": directory '" + dir.string() + "' does not exist");
@@ -104,7 +137,7 @@ void check_output_file(const std::string& path, bool overwrite) {
         return;
     }
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists (pass --overwrite to replace it)");
-    const fs::path dir = folder_of(kind == Target::file ? file_named(path) : fs::path(path));
+    const fs::path dir = folder_of(file_named(path));
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": no folder " + dir.string() + " to write it in");
     if (::access(dir.c_str(), W_OK | X_OK) != 0) {  // the temporary file is made there
