@@ -45,17 +45,28 @@ void print_error(const std::exception& e);
 // The program's name, as start() was given it.
 const char* program();
 
-// CLI11's exit for a command line it refused, or for --help: every process parsed the same line, so
-// the leader speaks for all. --help and its kind print what they ask for, status 0; a refused line is
-// bad input like any other, one line "PROGRAM: error: ..." naming the option and status 1 (CLI11's
-// own form was two lines and a status of 101 to 114).
+// Runs `step` on every process; when it throws on any, it throws on all, naming the first process at
+// fault and its cause (in the plain program: `step` itself).
+void together(const std::function<void()>& step, const std::string& name);
+
+// CLI11's exit for a command line it refused, or for --help. --help and its kind print what they ask
+// for (the leader speaks for all), status 0; a refused line is bad input like any other, one line
+// "PROGRAM: error: ..." naming the option and status 1 (CLI11's own form was two lines and a status of
+// 101 to 114).
 inline int exit_parse(const CLI::App& app, const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
         if (leader()) return app.exit(e);
         std::ostringstream silent;
         return app.exit(e, silent, silent);
     }
-    if (leader()) std::fprintf(stderr, "%s: error: %s (see --help)\n", program(), e.what());
+    // Through the processes' first agreement, which the others reach once their command lines are
+    // read: a rank whose command line alone is bad (mpirun's form `A : B`) ends the job at once, named,
+    // where the others used to wait for it until their time-out.
+    try {
+        together([&] { throw Error(std::string(e.what()) + " (see --help)"); }, "reading the command line");
+    } catch (const std::exception& refused) {
+        print_error(refused);
+    }
     return 1;
 }
 
@@ -125,10 +136,6 @@ inline void strict_numbers(CLI::App& app) {
 void add_render_options(CLI::App& cmd);
 void add_sweep_options(CLI::App& cmd);
 void add_bench_options(CLI::App& cmd);
-
-// Runs `step` on every process; when it throws on any, it throws on all, naming the first process at
-// fault and its cause (in the plain program: `step` itself).
-void together(const std::function<void()>& step, const std::string& name);
 
 // The scene `spec` on every process (cellrt::load_scene in the plain program).
 Scene load_scene(const std::string& spec);

@@ -53,8 +53,10 @@ for n in names:
     frame_wall = med(wall[(n, size)]) - med(wall[(n, "16x16")])
     frame_cpu = med(cpu[(n, size)]) - med(cpu[(n, "16x16")])
     base = base or (med(t), frame_wall, frame_cpu)
+    # A frame too small for /usr/bin/time's 10 ms shows no CPU time: its ratio is not a number.
+    cpu_ratio = f"{frame_cpu / base[2]:6.3f}" if base[2] > 0 else "     –"
     print(f"{n:16} {med(t):9.4f} {min(t):6.3f} {max(t):6.3f} {med(t) / base[0]:6.3f} {frame_wall:13.4f} "
-          f"{frame_wall / base[1]:6.3f} {frame_cpu:12.3f} {frame_cpu / base[2]:6.3f}")
+          f"{frame_wall / base[1]:6.3f} {frame_cpu:12.3f} {cpu_ratio}")
     if "ranks" in runs[-1]:
         for k in runs[-1]["ranks"]:
             print(f"    rank {k['rank']}: {k['threads']} threads, {k['tiles']} tiles, busy {k['busy_seconds']:.3f} s of "

@@ -339,6 +339,26 @@ TEST_F(Distributed, RanksWithDifferentScenesAreRefused) {
     expect_failure(o, out, "rank 1: ", "differs from rank 0's");
 }
 
+// Found by review (2026-12-07): a rank started with another --size made a wrong frame, status 0 (the
+// scene's fingerprint covers the view file's size only); a rank whose command line alone was bad, or
+// that alone was given --broadcast-scene, left the others waiting until their time-out, and the
+// message named the time-out, not the cause.
+TEST_F(Distributed, RanksStartedWithOtherOptionsAreRefusedAtOnce) {
+    const fs::path out = dir.path / "frame.pfm";
+    const std::string render = mpi + " render " + kScene + " --rank-timeout 60 -o " + out.string();
+    expect_failure(shell(mpirun(2) + render + " --size 64x64 : -np 1 " + render + " --size 64x65", dir.path), out,
+                   "rank 2: ", "its frame (64x65, direct shading, tiles of 128 ahead 3, float pixels by window) differs "
+                   "from rank 0's (64x64, ");
+    expect_failure(shell(mpirun(1) + render + " : -np 1 " + render + " --shading ao", dir.path), out, "rank 1: ",
+                   "its frame (");
+    const auto started = std::chrono::steady_clock::now();
+    expect_failure(shell(mpirun(2) + render + " : -np 1 " + render + " --bogus", dir.path), out, "rank 2: ",
+                   "The following argument was not expected: --bogus (see --help)");
+    expect_failure(shell(mpirun(1) + render + " --broadcast-scene : -np 1 " + render, dir.path), out, "rank 1: ",
+                   "it was started without --broadcast-scene, rank 0 with it");
+    EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(50)) << "a rank waited out its time-out";
+}
+
 TEST_F(Distributed, ABadOptionIsOneMessage) {
     const fs::path out = dir.path / "frame.png";
     expect_failure(shell(mpirun(3) + mpi + " render " + kScene + " --packet 0 -o " + out.string(), dir.path), out,

@@ -10,6 +10,8 @@
 #include <string>
 #include <utility>
 
+#include "cellrt/error.hpp"
+#include "cellrt/workload.hpp"
 #include "cluster.hpp"
 #include "distributed/scene_transfer.hpp"
 #include "distributed/session.hpp"
@@ -100,6 +102,14 @@ void add_bench_options(CLI::App& cmd) { add_timeout_option(cmd, kLongestRankTime
 void together(const std::function<void()>& step, const std::string& name) { session().together(step, name); }
 
 Scene load_scene(const std::string& spec) {
+    // Every rank on one side of the broadcast: a rank loading the file while rank 0 sends it would
+    // wait for its part of the broadcast until the time-out.
+    const std::string mine = g_options.broadcast_scene ? "with" : "without";
+    const std::string leaders = broadcast(mine);
+    together([&] {
+        if (mine != leaders)
+            throw Error("it was started " + mine + " --broadcast-scene, rank 0 " + leaders + " it");
+    }, "comparing --broadcast-scene");
     return distributed::load_scene_on_every_rank(session(), spec, g_options.broadcast_scene);
 }
 
@@ -109,6 +119,22 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     distributed::TileOptions tiles = g_options.tiles;
     tiles.srgb8 = png;
     tiles.gather = g_options.gather == "messages" ? distributed::TileGather::messages : distributed::TileGather::window;
+    // Every rank traces the frame rank 0 gathers: what decides its pixels (the size, the shading,
+    // Embree or an exact structure) and the tiles' exchange. The scene's fingerprint covers the view
+    // file's size only: a rank started with another --size (mpirun's `A : B`) made a wrong frame
+    // without a word (found by review, 2026-12-07). The structure, threads and dispatch may differ.
+    const std::string mine = std::to_string(options.width) + "x" + std::to_string(options.height) + ", " +
+                             to_string(options.shading.shading) + " shading" +
+                             (options.shading.shading == Shading::ao
+                                  ? " with " + std::to_string(options.shading.ao_samples) + " AO rays"
+                                  : std::string()) +
+                             (accel.stats().name == "embree" ? ", Embree" : "") + ", tiles of " +
+                             std::to_string(tiles.tile) + " ahead " + std::to_string(tiles.ahead) + ", " +
+                             (png ? "PNG" : "float") + " pixels by " + g_options.gather;
+    const std::string leaders = broadcast(mine);
+    together([&] {
+        if (mine != leaders) throw Error("its frame (" + mine + ") differs from rank 0's (" + leaders + ")");
+    }, "comparing the frames");
     distributed::render_tiles(session(), scene, accel, options, tiles, frame, &stats, &loads);
     if (!leader()) return;
     report["tile"] = tiles.tile;
