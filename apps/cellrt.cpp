@@ -20,11 +20,7 @@ int run(int argc, char** argv) {
     const std::vector<cli::Runner> runners = {cli::add_render(app), cli::add_info(app), cli::add_profile(app),
                                               cli::add_cache_study(app)};
     cli::cluster::strict_numbers(app);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return cli::cluster::exit_parse(app, e);
-    }
+    if (const int status = cli::cluster::parse(app, argc, argv); status >= 0) return status;
     const auto subcommands = app.get_subcommands({});
     std::size_t chosen = 0;
     for (std::size_t i = 0; i < subcommands.size(); ++i)

@@ -16,6 +16,7 @@
 #include <string_view>
 #include <system_error>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -48,27 +49,6 @@ const char* program();
 // Runs `step` on every process; when it throws on any, it throws on all, naming the first process at
 // fault and its cause (in the plain program: `step` itself).
 void together(const std::function<void()>& step, const std::string& name);
-
-// CLI11's exit for a command line it refused, or for --help. --help and its kind print what they ask
-// for (the leader speaks for all), status 0; a refused line is bad input like any other, one line
-// "PROGRAM: error: ..." naming the option and status 1 (CLI11's own form was two lines and a status of
-// 101 to 114).
-inline int exit_parse(const CLI::App& app, const CLI::ParseError& e) {
-    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
-        if (leader()) return app.exit(e);
-        std::ostringstream silent;
-        return app.exit(e, silent, silent);
-    }
-    // Through the processes' first agreement, which the others reach once their command lines are
-    // read: a rank whose command line alone is bad (mpirun's form `A : B`) ends the job at once, named,
-    // where the others used to wait for it until their time-out.
-    try {
-        together([&] { throw Error(std::string(e.what()) + " (see --help)"); }, "reading the command line");
-    } catch (const std::exception& refused) {
-        print_error(refused);
-    }
-    return 1;
-}
 
 // Refuses a list option that names one value twice (`--structures kd kd`, `--packets 8 8`): its runs
 // would be made and written twice.
@@ -159,6 +139,40 @@ std::vector<std::string> gather(const std::string& mine);
 
 // The leader's `leaders` on every process.
 std::string broadcast(const std::string& leaders);
+
+// Parses the command line into `app` on every process and agrees on the outcome: -1 to go on, else
+// the exit status. --help and its kind print what they ask for (the leader speaks for all), status 0;
+// a refused line is bad input like any other, one line "PROGRAM: error: ..." naming the option,
+// status 1 (CLI11's own form was two lines and a status of 101 to 114). Under MPI a rank whose line
+// alone is refused, or alone asks for --help (mpirun's `A : B` form), ends the job at once, named,
+// where the others used to wait for it until their time-out, or pair unlike collectives.
+inline int parse(CLI::App& app, int argc, char** argv) {
+    std::optional<int> help;
+    std::ostringstream help_out, help_err;
+    std::string refused;
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) help = app.exit(e, help_out, help_err);
+        else refused = std::string(e.what()) + " (see --help)";
+    }
+    try {
+        together([&] { if (!refused.empty()) throw Error(refused); }, "reading the command line");
+        const std::string mine = help ? "asked for --help" : "did not ask for --help";
+        const std::string leaders = broadcast(mine);
+        together([&] { if (mine != leaders) throw Error("it " + mine + ", rank 0 " + leaders.substr(0, leaders.find(" for"))); },
+                 "comparing --help");
+    } catch (const std::exception& e) {
+        print_error(e);
+        return 1;
+    }
+    if (!help) return -1;
+    if (leader()) {
+        std::fputs(help_out.str().c_str(), stdout);
+        std::fputs(help_err.str().c_str(), stderr);
+    }
+    return *help;
+}
 
 // The results of the runs 0..count-1 on the leader, in run order (empty elsewhere), from each
 // process's results of its share: results[k] is run mine[k]'s, mine = share(count).

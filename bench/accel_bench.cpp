@@ -125,11 +125,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         ->check(CLI::IsMember({"wall", "cpu"}));
     cluster::add_bench_options(app);
     cluster::strict_numbers(app);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return cluster::exit_parse(app, e);
-    }
+    if (const int status = cluster::parse(app, argc, argv); status >= 0) return status;
     o.scenes_named = app.count("--scenes") > 0;
     cluster::together([&] {
         bench::check_configs(o.configs);

@@ -252,11 +252,7 @@ int main(int argc, char** argv) {
     app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
     cli::cluster::start(argc, argv, "cellrt_gpu_bench");
     cli::cluster::strict_numbers(app);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return cli::cluster::exit_parse(app, e);
-    }
+    if (const int status = cli::cluster::parse(app, argc, argv); status >= 0) return status;
     try {
         if (!o.json_path.empty()) check_output_file(o.json_path, o.overwrite);
     } catch (const Error& e) {

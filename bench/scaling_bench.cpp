@@ -133,11 +133,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_flag("--overwrite", o.overwrite, "Replace existing --csv and --json files");
     cluster::add_bench_options(app);
     cluster::strict_numbers(app);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return cluster::exit_parse(app, e);
-    }
+    if (const int status = cluster::parse(app, argc, argv); status >= 0) return status;
     cluster::together([&] {
         try {
             o.shading.shading = parse_shading(shading);

@@ -341,8 +341,8 @@ TEST_F(Distributed, RanksWithDifferentScenesAreRefused) {
 
 // Found by review (2026-12-07): a rank started with another --size made a wrong frame, status 0 (the
 // scene's fingerprint covers the view file's size only); a rank whose command line alone was bad, or
-// that alone was given --broadcast-scene, left the others waiting until their time-out, and the
-// message named the time-out, not the cause.
+// that alone was given --broadcast-scene or --help, left the others waiting until their time-out, and
+// the message named the time-out, not the cause.
 TEST_F(Distributed, RanksStartedWithOtherOptionsAreRefusedAtOnce) {
     const fs::path out = dir.path / "frame.pfm";
     const std::string render = mpi + " render " + kScene + " --rank-timeout 60 -o " + out.string();
@@ -356,6 +356,9 @@ TEST_F(Distributed, RanksStartedWithOtherOptionsAreRefusedAtOnce) {
                    "The following argument was not expected: --bogus (see --help)");
     expect_failure(shell(mpirun(1) + render + " --broadcast-scene : -np 1 " + render, dir.path), out, "rank 1: ",
                    "it was started without --broadcast-scene, rank 0 with it");
+    // --help on one rank only: its exit used to be paired with the others' first agreement.
+    expect_failure(shell(mpirun(1) + render + " : -np 1 " + render + " --help", dir.path), out, "rank 1: ",
+                   "it asked for --help, rank 0 did not ask");
     EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(50)) << "a rank waited out its time-out";
 }
 

@@ -150,6 +150,12 @@ TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     write_image(img, ahead, false);
     EXPECT_TRUE(std::filesystem::is_symlink(ahead));
     EXPECT_TRUE(same_bits(read_pfm((dir / "later.pfm").string()), img));
+    // A loop of links is refused as a shell refuses it, not broken by a file put in its way.
+    std::filesystem::create_symlink("loop_b.pfm", dir / "loop_a.pfm");
+    std::filesystem::create_symlink("loop_a.pfm", dir / "loop_b.pfm");
+    const std::string loop = (dir / "loop_a.pfm").string();
+    EXPECT_EQ(test::error_of([&] { write_image(img, loop, true); }), loop + ": too many levels of links");
+    EXPECT_TRUE(std::filesystem::is_symlink(dir / "loop_b.pfm"));
     const std::string folder = (dir / "folder.pfm").string();
     std::filesystem::create_directories(folder);
     EXPECT_EQ(test::error_of([&] { write_image(img, folder, true); }), folder + ": is a folder, not a file");
@@ -184,12 +190,19 @@ TEST(Render, TheProcesssOwnStandardOutputIsWrittenThroughItsStream) {
         std::printf("table\n");  // held in stdout's buffer: it is a file now
         try {
             write_file_atomically("/dev/stdout", "results\n", false);
+            // The log under its own name is the process's stdout too: not renamed over, nor refused
+            // as an existing file (`--json log > log`).
+            check_output_file(log, false);
+            write_file_atomically(log, "again\n", false);
         } catch (...) {
             ::_exit(3);
         }
         std::printf("after\n");
         std::fflush(stdout);
-        ::_exit(0);
+        // With stdout closed, /dev/stdout leads nowhere: refused, not made a file under /proc.
+        ::close(STDOUT_FILENO);
+        const std::string closed = test::error_of([] { check_output_file("/dev/stdout", true); });
+        ::_exit(closed == "/dev/stdout: is not there (a closed stream?)" ? 0 : 4);
     }
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
@@ -197,7 +210,7 @@ TEST(Render, TheProcesssOwnStandardOutputIsWrittenThroughItsStream) {
     EXPECT_EQ(WEXITSTATUS(status), 0);
     std::ifstream written(log);
     EXPECT_EQ((std::string{std::istreambuf_iterator<char>(written), std::istreambuf_iterator<char>()}),
-              "table\nresults\nafter\n");
+              "table\nresults\nagain\nafter\n");
     std::filesystem::remove(log);
 }
 

@@ -27,34 +27,6 @@ namespace fs = std::filesystem;
 // replace (and truncating would wipe).
 enum class Target { none, file, folder, stream };
 
-Target target_of(const std::string& path) {
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (!fs::exists(st)) return Target::none;
-    if (fs::is_directory(st)) return Target::folder;
-    const bool system = path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
-    return fs::is_regular_file(st) && !system ? Target::file : Target::stream;
-}
-
-// A path as the file it names: links and dots resolved where the system can, else as written. Its
-// folder takes the temporary file, and the rename replaces the file, not a link to it. A link whose
-// file is not there yet is followed too (as a shell's `>` follows it): it names that file, the one a
-// write makes and another output may name directly.
-fs::path file_named(const std::string& path) {
-    std::error_code ec;
-    fs::path p = fs::absolute(path, ec);
-    if (ec) p = path;
-    for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
-        const fs::path to = fs::read_symlink(p, ec);
-        if (ec) break;
-        p = to.is_absolute() ? to : p.parent_path() / to;
-    }
-    const fs::path resolved = fs::weakly_canonical(p, ec);
-    return ec ? p.lexically_normal() : resolved;
-}
-
-fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
-
 // The process's own standard output or error when `path` leads to the same file, else null. Their
 // bytes go through that stream, after what it holds buffered: a second descriptor of a redirected
 // file (`--json /dev/stdout > log`) would write at an offset of its own, and the program's tables,
@@ -68,6 +40,39 @@ std::FILE* own_stream(const std::string& path) {
     }
     return nullptr;
 }
+
+bool system_path(const std::string& path) { return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0; }
+
+Target target_of(const std::string& path) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) return Target::none;
+    if (fs::is_directory(st)) return Target::folder;
+    // The process's own output is a stream whatever names it (`--json log > log`, a link to /dev/stdout).
+    return fs::is_regular_file(st) && !system_path(path) && !own_stream(path) ? Target::file : Target::stream;
+}
+
+// A path as the file it names: links and dots resolved where the system can, else as written. Its
+// folder takes the temporary file, and the rename replaces the file, not a link to it. A link whose
+// file is not there yet is followed too (as a shell's `>` follows it): it names that file, the one a
+// write makes and another output may name directly.
+fs::path file_named(const std::string& path) {
+    std::error_code ec;
+    fs::path p = fs::absolute(path, ec);
+    if (ec) p = path;
+    for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+        // A loop, or a chain longer than the system follows: refused as `>` refuses it, rather than
+        // a file put in place of the last link looked at.
+        if (hops == 40) throw Error(path + ": too many levels of links");
+        const fs::path to = fs::read_symlink(p, ec);
+        if (ec) break;
+        p = to.is_absolute() ? to : p.parent_path() / to;
+    }
+    const fs::path resolved = fs::weakly_canonical(p, ec);
+    return ec ? p.lexically_normal() : resolved;
+}
+
+fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
 
 // Appended, so that a stream that leads to a file (a shell's `> log`) is not truncated.
 void write_in_place(const std::string& path, std::string_view bytes) {
@@ -84,6 +89,12 @@ void write_in_place(const std::string& path, std::string_view bytes) {
     if (!out) throw Error(path + ": write failed");
 }
 
+// A path under /dev or /proc that leads nowhere (`/dev/stdout` of a process whose stdout is closed):
+// a file made there would be renamed over a link the system keeps.
+void check_system_path(const std::string& path, Target kind) {
+    if (kind == Target::none && system_path(path)) throw Error(path + ": is not there (a closed stream?)");
+}
+
 }  // namespace
 
 std::string lower_extension(const std::string& path) {
@@ -94,6 +105,7 @@ std::string lower_extension(const std::string& path) {
 
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite) {
     const Target kind = target_of(path);
+    check_system_path(path, kind);
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
     if (kind == Target::stream) return write_in_place(path, bytes);
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists and overwrite is off");
@@ -128,6 +140,7 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
 void check_output_file(const std::string& path, bool overwrite) {
     if (path.empty()) throw Error("an output file's name is empty");
     const Target kind = target_of(path);
+    check_system_path(path, kind);
     if (kind == Target::folder) throw Error(path + ": is a folder, not a file");
     if (kind == Target::stream) {  // written in place
         if (::access(path.c_str(), W_OK) != 0) {
