@@ -417,15 +417,13 @@ Runner add_cache_study(CLI::App& app) {
                                     runs.push_back(run);
                                 }
                 }
-                // Every run's local store checked before the frame is traced: a --packet whose batch
-                // leaves no room for the largest swept cache fails here, not after the tracing.
+                // Every run's local store made once before the frame is traced, as the run will make
+                // it: a --packet whose batch leaves no room for the largest swept cache fails here, not
+                // after the tracing.
                 if (!gpu)
                     for (const Run& run : runs) {
-                        std::size_t stack = 0;
-                        for (const LocalStoreAllocation& a : bases.at(run.structure)->local_store_allocations())
-                            if (a.what == kStackAllocation) stack = a.bytes;
                         try {
-                            allocate_local_store(run.config, stack);
+                            bases.at(run.structure)->with_local_store(run.config, run.traversal);
                         } catch (const Error& e) {
                             throw Error("--packet " + std::to_string(o->packet) + ": " + e.what());
                         }

@@ -118,7 +118,7 @@ namespace {
 
 // `x` as the float32 on the bound's inner side: the nearest float, stepped once toward the inside where
 // rounding to nearest crossed `x` (tfar = 1 - 1e-8 in float64 is 1.0f to nearest, which would let a hit
-// at t = 1 through).
+// at t = 1 through). A NaN stays NaN (both compares are false), for the caller to refuse.
 template <class T>
 float inner_float(T x, Inward inward) {
     float f = static_cast<float>(x);
@@ -142,13 +142,11 @@ py::array_t<float> inner_floats(const py::array& a, const std::string& name, Inw
         each("float32", [](py::ssize_t i, const void* d) { return static_cast<const float*>(d)[i]; });
     } else if (kind == 'f' && a.itemsize() <= 8) {
         each("float64", [&](py::ssize_t i, const void* d) {
-            const double x = static_cast<const double*>(d)[i];
-            return std::isnan(x) ? static_cast<float>(x) : inner_float(x, inward);
+            return inner_float(static_cast<const double*>(d)[i], inward);
         });
     } else if (kind == 'f') {
         each("longdouble", [&](py::ssize_t i, const void* d) {
-            const long double x = static_cast<const long double*>(d)[i];
-            return std::isnan(x) ? static_cast<float>(x) : inner_float(x, inward);
+            return inner_float(static_cast<const long double*>(d)[i], inward);
         });
     } else if (kind == 'u') {
         each("uint64", [&](py::ssize_t i, const void* d) {

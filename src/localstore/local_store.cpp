@@ -33,7 +33,7 @@ std::vector<LocalStoreAllocation> allocate_local_store(const LocalStoreConfig& c
     const std::vector<LocalStoreAllocation> allocations = {
         cache("node cache", config.node_cache),
         cache("triangle cache", config.triangle_cache),
-        {kStackAllocation, stack_bytes},
+        {"traversal stack", stack_bytes},
         {"batch of " + std::to_string(config.batch_rays) + " rays and results",
          config.batch_rays * (sizeof(Ray) + sizeof(Hit))},
     };

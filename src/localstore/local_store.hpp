@@ -52,9 +52,6 @@ struct LocalStoreAllocation {
 // The largest budget the model takes: 4 GiB - 1, as its transfers count bytes in 32 bits.
 inline constexpr std::size_t kMaxLocalStoreBytes = 0xffff'ffff;
 
-// The name of the traversal stack's allocation, as allocate_local_store lists it.
-inline constexpr const char* kStackAllocation = "traversal stack";
-
 // The most rays a batch may hold in a local store of `budget_bytes`, each with its result, before
 // anything else is allocated.
 std::size_t max_batch_rays(std::size_t budget_bytes);
