@@ -35,7 +35,6 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include "kernel/box_lanes.hpp"
@@ -199,12 +198,7 @@ public:
     BihTree build() {
         BihTree tree;
         auto run = [&] { build_into(tree); };
-        if (p_.threads == 1) {
-            run();
-        } else {
-            tbb::task_arena arena(build_concurrency(p_.threads));
-            arena.execute(run);
-        }
+        run_build(p_.threads, run);
         return tree;
     }
 

@@ -7,7 +7,6 @@
 #include <limits>
 #include <utility>
 
-#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include "cellrt/error.hpp"
@@ -140,12 +139,7 @@ public:
         }
         root_area_ = area(root);
         auto run = [&] { build(tree_, std::move(refs), 0, o_.split_budget * static_cast<double>(tris_.size())); };
-        if (o_.threads == 1) {
-            run();
-        } else {
-            tbb::task_arena arena(build_concurrency(o_.threads));
-            arena.execute(run);
-        }
+        run_build(o_.threads, run);
         // Summed in the nodes' order, which is the depth-first order of the sequential recursion:
         // the same bits at any thread count.
         for (const BinaryNode& n : tree_.nodes)

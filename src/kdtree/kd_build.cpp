@@ -29,7 +29,6 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include "cellrt/error.hpp"
@@ -148,12 +147,7 @@ public:
             const std::unique_ptr<Subtree<KdNode>> top = subtree(std::move(root));
             flatten(*top, 0, tree.nodes, tree.indices, KdNode::kMaxIndex, "kd-tree", p_.threads != 1);
         };
-        if (p_.threads == 1) {
-            run();
-        } else {
-            tbb::task_arena arena(build_concurrency(p_.threads));
-            arena.execute(run);
-        }
+        run_build(p_.threads, run);
         return tree;
     }
 

@@ -19,6 +19,7 @@
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "cellrt/error.hpp"
 
@@ -39,6 +40,18 @@ struct Subtree {
 inline int build_concurrency(unsigned requested) {
     const int cores = tbb::info::default_concurrency();
     return requested == 0 ? cores : static_cast<int>(std::min(static_cast<unsigned>(cores), requested));
+}
+
+// Runs `build` on the calling thread for one thread, else in an arena of build_concurrency(threads)
+// slots: a build's tasks use the threads the user asked for, and no more.
+template <class Build>
+void run_build(unsigned threads, Build&& build) {
+    if (threads == 1) {
+        build();
+        return;
+    }
+    tbb::task_arena arena(build_concurrency(threads));
+    arena.execute(build);
 }
 
 // Checks an index against the `max` a node can encode; throws naming the structure otherwise.
