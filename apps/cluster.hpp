@@ -140,6 +140,16 @@ std::vector<std::string> gather(const std::string& mine);
 // The leader's `leaders` on every process.
 std::string broadcast(const std::string& leaders);
 
+// Compares this process's `mine` with the leader's. Where they differ, the step `name` fails on every
+// process (`together`) with `differs(mine, leaders)` as its message: settings that must be one for the
+// whole job (mpirun's `A : B` form can start ranks with different lines) are checked before any
+// collective that depends on them, which would otherwise wait for its time-out or pair unlike calls.
+inline void agree(const std::string& mine, const std::string& name,
+                  const std::function<std::string(const std::string& mine, const std::string& leaders)>& differs) {
+    const std::string leaders = broadcast(mine);
+    together([&] { if (mine != leaders) throw Error(differs(mine, leaders)); }, name);
+}
+
 // Parses the command line into `app` on every process and agrees on the outcome: -1 to go on, else
 // the exit status. --help and its kind print what they ask for (the leader speaks for all), status 0;
 // a refused line is bad input like any other, one line "PROGRAM: error: ..." naming the option,
@@ -158,10 +168,10 @@ inline int parse(CLI::App& app, int argc, char** argv) {
     }
     try {
         together([&] { if (!refused.empty()) throw Error(refused); }, "reading the command line");
-        const std::string mine = help ? "asked for --help" : "did not ask for --help";
-        const std::string leaders = broadcast(mine);
-        together([&] { if (mine != leaders) throw Error("it " + mine + ", rank 0 " + leaders.substr(0, leaders.find(" for"))); },
-                 "comparing --help");
+        agree(help ? "asked for --help" : "did not ask for --help", "comparing --help",
+              [](const std::string& mine, const std::string& leaders) {
+                  return "it " + mine + ", rank 0 " + leaders.substr(0, leaders.find(" for"));
+              });
     } catch (const std::exception& e) {
         print_error(e);
         return 1;

@@ -104,12 +104,10 @@ void together(const std::function<void()>& step, const std::string& name) { sess
 Scene load_scene(const std::string& spec) {
     // Every rank on one side of the broadcast: a rank loading the file while rank 0 sends it would
     // wait for its part of the broadcast until the time-out.
-    const std::string mine = g_options.broadcast_scene ? "with" : "without";
-    const std::string leaders = broadcast(mine);
-    together([&] {
-        if (mine != leaders)
-            throw Error("it was started " + mine + " --broadcast-scene, rank 0 " + leaders + " it");
-    }, "comparing --broadcast-scene");
+    agree(g_options.broadcast_scene ? "with" : "without", "comparing --broadcast-scene",
+          [](const std::string& mine, const std::string& leaders) {
+              return "it was started " + mine + " --broadcast-scene, rank 0 " + leaders + " it";
+          });
     return distributed::load_scene_on_every_rank(session(), spec, g_options.broadcast_scene);
 }
 
@@ -131,10 +129,9 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
                              (accel.stats().name == "embree" ? ", Embree" : "") + ", tiles of " +
                              std::to_string(tiles.tile) + " ahead " + std::to_string(tiles.ahead) + ", " +
                              (png ? "PNG" : "float") + " pixels by " + g_options.gather;
-    const std::string leaders = broadcast(mine);
-    together([&] {
-        if (mine != leaders) throw Error("its frame (" + mine + ") differs from rank 0's (" + leaders + ")");
-    }, "comparing the frames");
+    agree(mine, "comparing the frames", [](const std::string& mine, const std::string& leaders) {
+        return "its frame (" + mine + ") differs from rank 0's (" + leaders + ")";
+    });
     distributed::render_tiles(session(), scene, accel, options, tiles, frame, &stats, &loads);
     if (!leader()) return;
     report["tile"] = tiles.tile;
