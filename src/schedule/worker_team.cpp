@@ -146,8 +146,13 @@ void WorkerTeam::set_affinity(bool pin) {
 #endif
 }
 
+// Never destroyed. A static's destructor would, at exit, wait for a run that another thread is still
+// making (a render in a Python daemon thread when the interpreter ends), and that thread, resumed in a
+// finalized interpreter, would then be unwound by pthread_exit through pybind11's noexcept GIL guard:
+// std::terminate, exit status 134 (found by audit, 2026-12-07). Left alone, the team's threads end with
+// the process, as TBB's do.
 WorkerTeam& worker_team() {
-    static WorkerTeam team;
+    static WorkerTeam& team = *new WorkerTeam;
     return team;
 }
 

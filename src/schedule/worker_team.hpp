@@ -72,7 +72,7 @@ private:
     std::exception_ptr failure_;  // the current run's first exception
 };
 
-// The process's team, shared by every render.
+// The process's team, shared by every render; its threads live as long as the process.
 WorkerTeam& worker_team();
 
 }  // namespace cellrt::detail

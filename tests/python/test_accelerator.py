@@ -1,5 +1,7 @@
 """Every kind and instruction set from Python against brute force, bit for bit; the two ways to give
 triangles; conversions and the zero-copy path; threads, concurrency and the GIL; the statistics."""
+import subprocess
+import sys
 import threading
 import time
 
@@ -161,6 +163,18 @@ def test_the_gil_is_released_while_tracing():
     worker.join()
     # Held, the GIL would stall this loop for the whole trace.
     assert max(gaps) < 0.5 * alone, (max(gaps), alone)
+
+
+def test_the_interpreter_ends_while_a_daemon_thread_renders():
+    # The render's worker team was a static whose destructor waited at exit for the run; the thread,
+    # resumed in a finalized interpreter, then ended in std::terminate (status 134).
+    code = ("import threading, time, cellrt\n"
+            "scene = cellrt.load_scene('builtin:city?tris=2000')\n"
+            "threading.Thread(target=cellrt.render, args=(scene,), daemon=True,\n"
+            "                 kwargs=dict(size=(4096, 4096), shading='ao', ao_samples=16, threads=2)).start()\n"
+            "time.sleep(0.3)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
 
 
 def test_stats_are_typed(city):
