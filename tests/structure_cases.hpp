@@ -2,6 +2,7 @@
 // catalogue of degenerate inputs (after Embree's verify suite).
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -86,6 +87,27 @@ inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_sce
         zero.push_back({p, q, Vec3{next() * 4, next() * 4, next() * 4}});
     }
     out.push_back({"zero area", zero});
+
+    // Slivers (12 long, some 1e-6 wide), whose float t strays along them by more than the margins,
+    // and triangles of exactly zero area (collinear vertices on small integers) beside real ones,
+    // which rounding gives a determinant: brute force took hits there that structures culled
+    // (found by audit, 2026-12-07; triangle.hpp, ill_conditioned).
+    std::vector<Triangle> slivers;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 a{next() * 4, next() * 4, next() * 4};
+        const Vec3 b = a + Vec3{next() - 0.5f, next() - 0.5f, next() - 0.5f} * 12.f;
+        const Vec3 c = a + (b - a) * next() + Vec3{next() - 0.5f, next() - 0.5f, next() - 0.5f} * 2e-6f;
+        slivers.push_back({a, b, c});
+    }
+    out.push_back({"slivers", slivers});
+    std::vector<Triangle> collinear;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 p{std::floor(next() * 8), std::floor(next() * 8), std::floor(next() * 8)};
+        const Vec3 d{std::floor(next() * 5) - 2, std::floor(next() * 5) - 2, std::floor(next() * 5) - 2};
+        collinear.push_back({p, p + d, p + d * 2.f});
+        collinear.push_back({p + Vec3{0.25f, 0.f, 0.f}, p + d + Vec3{0.f, 0.5f, 0.f}, p + d * 2.f + Vec3{0.f, 0.f, 0.5f}});
+    }
+    out.push_back({"collinear", collinear});
 
     std::vector<Triangle> huge;  // tiny triangles near the origin and enormous ones far away
     for (int i = 0; i < 200; ++i) {

@@ -23,6 +23,7 @@ inline constexpr std::uint32_t kNoHit = std::numeric_limits<std::uint32_t>::max(
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 inline constexpr float kLargestFloat = std::numeric_limits<float>::max();
 inline constexpr float kLeastNormal = std::numeric_limits<float>::min();  // 2^-126
+inline constexpr float kLeastSubnormal = 0x1p-149f;
 
 struct Ray {
     Vec3 org;

@@ -9,6 +9,7 @@
 // recomputed in double precision (section 3 of the paper) so that the sign of a tiny value is right.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -78,6 +79,82 @@ CELLRT_HD inline bool det_in_range(float det) {
     return a >= kLeastNormal && a < kInfinity;
 }
 
+// An edge function recomputed in double precision, where its float value is exactly zero: the
+// products of floats are exact in double and their difference is correctly signed. Rounded back to
+// float it may still be zero (below half the least subnormal): its sign is then kept in the least
+// subnormal, so that the sign test sees the side the double found. Lost, a ray 1e-35 off an edge of
+// a 1e-10 triangle counted as on the edge: brute force took it, every structure's box test culled
+// it (found by audit, 2026-12-07).
+CELLRT_HD inline float edge_in_double(float a, float b, float c, float d) {
+    const double e = double(a) * double(b) - double(c) * double(d);
+    const float f = static_cast<float>(e);
+    if (f != 0.f || e == 0.0) return f;
+    return e > 0.0 ? kLeastSubnormal : -kLeastSubnormal;
+}
+
+// Hits whose t the float test cannot place. Woop et al.'s t is the depth of a barycentric mean of
+// the vertices; where the edge functions cancel (a sliver, a triangle of zero area that rounding
+// gave a determinant, a triangle seen at a grazing angle), their rounding errors move that point
+// along the triangle, and t with it, by more than the structures' margins allow (kernel/traversal.hpp:
+// 2^-16 of the scene's reach). Brute force then took hits at points off the ray that every structure
+// culled (found by audit, 2026-12-07). An edge function's error is a few ulps of the products of the
+// sheared coordinates, at most `lateral` (their largest magnitude) squared or `lateral` times their
+// unsheared size; over det it moves t by as many ulps times the triangle's depth range `depth` over
+// det / `lateral`. Where lateral * depth passes kIllConditioned * |det|, t is taken again in double
+// precision (refined_t). Healthy hits stay far below: a triangle seen at 45 degrees gives about 1,
+// at 5 degrees about 11.
+inline constexpr float kIllConditioned = 16.f;
+
+// Whether a hit with these magnitudes needs refined_t. The same operations in the same order on
+// every path (the scalar test, SSE2's, the lanes'), so that every path makes the same choice.
+CELLRT_HD inline bool ill_conditioned(float lateral, float depth, float det) {
+    return lateral * depth > kIllConditioned * std::fabs(det);
+}
+
+// t of an ill-conditioned hit, in double precision: the depth of the triangle's point nearest the
+// ray in the test's sheared frame (the ray the +z axis, t = depth * sz). Where the ray crosses the
+// triangle that is the crossing; where the float test found it inside by rounding only (a grazing
+// ray, a zero-area triangle rounding gave an area), the nearest point of an edge. That point lies on
+// the triangle, within rounding of the ray, so every structure whose cells or boxes hold that part
+// of the triangle reaches it within its margin: the crossing of the ray with the triangle's plane
+// did not (on a grazing ray it lay 0.25 off a triangle 1 long, inside its box, outside the kd cells
+// that hold it), and refusing such hits left holes where a zero-area triangle closes a T-junction
+// (both found by audit, 2026-12-07). x, y, z are the vertices' coordinates on the axes kx, ky, kz,
+// (ox, oy, oz) the origin's, (sx, sy, sz) the shear. False only where t is not finite.
+[[gnu::noinline]] CELLRT_NOINLINE CELLRT_HD inline bool refined_t(const float (&x)[3], const float (&y)[3],
+                                                                   const float (&z)[3], float ox, float oy, float oz,
+                                                                   float sx, float sy, float sz, float& t) {
+    double px[3], py[3], pz[3];  // the sheared frame: the ray at px = py = 0
+    for (int k = 0; k < 3; ++k) {
+        pz[k] = double(z[k]) - oz;
+        px[k] = (double(x[k]) - ox) - sx * pz[k];
+        py[k] = (double(y[k]) - oy) - sy * pz[k];
+    }
+    const double e[3] = {px[2] * py[1] - py[2] * px[1], px[0] * py[2] - py[0] * px[2], px[1] * py[0] - py[1] * px[0]};
+    const double det = e[0] + e[1] + e[2];
+    double depth;
+    if (det != 0.0 && ((e[0] >= 0.0 && e[1] >= 0.0 && e[2] >= 0.0) || (e[0] <= 0.0 && e[1] <= 0.0 && e[2] <= 0.0))) {
+        depth = (e[0] * pz[0] + e[1] * pz[1] + e[2] * pz[2]) / det;
+    } else {
+        // The nearest point of the three edges (the first edge on a tie), k to k + 1.
+        double nearest = 0.0;
+        depth = pz[0];
+        for (int k = 0; k < 3; ++k) {
+            const int j = k == 2 ? 0 : k + 1;
+            const double dx = px[j] - px[k], dy = py[j] - py[k], length2 = dx * dx + dy * dy;
+            double along = length2 > 0.0 ? -(px[k] * dx + py[k] * dy) / length2 : 0.0;
+            along = along < 0.0 ? 0.0 : (along > 1.0 ? 1.0 : along);
+            const double qx = px[k] + along * dx, qy = py[k] + along * dy, distance2 = qx * qx + qy * qy;
+            if (k == 0 || distance2 < nearest) {
+                nearest = distance2;
+                depth = pz[k] + along * (pz[j] - pz[k]);
+            }
+        }
+    }
+    t = static_cast<float>(depth * sz);
+    return std::fabs(t) < kInfinity;
+}
+
 // Core of the test: on success writes t = T/det and the barycentrics, without any range check.
 // Returns false when the ray misses the triangle's plane region or the triangle is degenerate
 // (det == 0: zero area, or seen edge-on), and where the float arithmetic left its range: det not a
@@ -85,7 +162,8 @@ CELLRT_HD inline bool det_in_range(float det) {
 // the ray in the sheared space), or t not finite (T grows as the cube of the distance, and
 // overflows some 1e13 away along a unit direction). t there is 0, noise or inf, which no
 // structure's interval reaches (an interval from tnear past the scene box, say, culls what brute
-// force would take): docs/HIT_SEMANTICS.md, "Known limits". Always inlined, as the
+// force would take): docs/HIT_SEMANTICS.md, "Known limits". An ill-conditioned hit's t is taken
+// again (refined_t). Always inlined, as the
 // per-ray set-up of the traversals (kernel/traversal.hpp): a unit that instantiates many kernels
 // exhausts GCC's inlining budget, and an out-of-line call costs a kernel up to a tenth of its
 // instructions (docs/BENCHMARKS.md).
@@ -102,9 +180,9 @@ CELLRT_HD inline bool det_in_range(float det) {
     float ev = ax * cy - ay * cx;
     float ew = bx * ay - by * ax;
     if (eu == 0.f || ev == 0.f || ew == 0.f) {
-        eu = static_cast<float>(double(cx) * double(by) - double(cy) * double(bx));
-        ev = static_cast<float>(double(ax) * double(cy) - double(ay) * double(cx));
-        ew = static_cast<float>(double(bx) * double(ay) - double(by) * double(ax));
+        eu = edge_in_double(cx, by, cy, bx);
+        ev = edge_in_double(ax, cy, ay, cx);
+        ew = edge_in_double(bx, ay, by, ax);
     }
     if ((eu < 0.f || ev < 0.f || ew < 0.f) && (eu > 0.f || ev > 0.f || ew > 0.f)) return false;
     const float det = eu + ev + ew;
@@ -115,13 +193,21 @@ CELLRT_HD inline bool det_in_range(float det) {
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return std::fabs(t) < kInfinity;
+    if (!(std::fabs(t) < kInfinity)) return false;
+    const float lateral = std::max(std::max(std::max(std::fabs(ax), std::fabs(bx)), std::fabs(cx)),
+                                   std::max(std::max(std::fabs(ay), std::fabs(by)), std::fabs(cy)));
+    const float depth = std::max(std::max(a_kz, b_kz), c_kz) - std::min(std::min(a_kz, b_kz), c_kz);
+    if (!ill_conditioned(lateral, depth, det)) [[likely]] return true;
+    const float xs[3] = {c9[r.kx], c9[3 + r.kx], c9[6 + r.kx]};
+    const float ys[3] = {c9[r.ky], c9[3 + r.ky], c9[6 + r.ky]};
+    const float zs[3] = {c9[r.kz], c9[3 + r.kz], c9[6 + r.kz]};
+    return refined_t(xs, ys, zs, ox, oy, oz, r.sx, r.sy, r.sz, t);
 }
 
 #if defined(CELLRT_SSE2_TRIANGLE)
-// The scalar test out of line, for the SSE2 test's rare edge functions of exactly zero: inlined, its
-// registers would crowd the common path's.
-[[gnu::noinline]] inline bool intersect_unbounded_exact_edges(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
+// The scalar test out of line, for the SSE2 test's rare edge functions of exactly zero and
+// ill-conditioned hits: inlined, its registers would crowd the common path's.
+[[gnu::noinline]] inline bool intersect_unbounded_rare(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     return intersect_unbounded_scalar(r, tri, t, u, v);
 }
 
@@ -129,7 +215,7 @@ CELLRT_HD inline bool det_in_range(float det) {
 // each lane runs the scalar test's operations in the same order, so every value carries the same
 // bits (tests/test_watertight.cpp compares the two on random, degenerate, axis-parallel and
 // edge-point rays). An edge function of exactly zero goes to the scalar test, whose double-precision
-// recomputation decides it.
+// recomputation decides it, and so does an ill-conditioned hit, whose t it takes again.
 [[gnu::always_inline]] inline bool intersect_unbounded_sse(const WatertightRay& r, const Triangle& tri, float& t, float& u, float& v) {
     const float* c9 = reinterpret_cast<const float*>(&tri);
     const __m128 cz = _mm_setr_ps(c9[r.kz], c9[3 + r.kz], c9[6 + r.kz], 0.f);
@@ -143,7 +229,7 @@ CELLRT_HD inline bool det_in_range(float det) {
     const __m128 y1 = _mm_shuffle_ps(y, y, _MM_SHUFFLE(3, 0, 2, 1)), y2 = _mm_shuffle_ps(y, y, _MM_SHUFFLE(3, 1, 0, 2));
     const __m128 e = _mm_sub_ps(_mm_mul_ps(x2, y1), _mm_mul_ps(y2, x1));
     const __m128 zero = _mm_setzero_ps();
-    if ((_mm_movemask_ps(_mm_cmpeq_ps(e, zero)) & 7) != 0) return intersect_unbounded_exact_edges(r, tri, t, u, v);
+    if ((_mm_movemask_ps(_mm_cmpeq_ps(e, zero)) & 7) != 0) return intersect_unbounded_rare(r, tri, t, u, v);
     if ((_mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7) != 0 && (_mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7) != 0)
         return false;
     const float eu = _mm_cvtss_f32(e), ev = _mm_cvtss_f32(_mm_shuffle_ps(e, e, 1)), ew = _mm_cvtss_f32(_mm_movehl_ps(e, e));
@@ -157,7 +243,15 @@ CELLRT_HD inline bool det_in_range(float det) {
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return std::fabs(t) < kInfinity;
+    if (!(std::fabs(t) < kInfinity)) return false;
+    const __m128 sign = _mm_set1_ps(-0.f);
+    const __m128 xy = _mm_max_ps(_mm_andnot_ps(sign, x), _mm_andnot_ps(sign, y));
+    const float lateral = std::max(std::max(_mm_cvtss_f32(xy), _mm_cvtss_f32(_mm_shuffle_ps(xy, xy, 1))),
+                                   _mm_cvtss_f32(_mm_movehl_ps(xy, xy)));
+    const float a_kz = _mm_cvtss_f32(dz), b_kz = _mm_cvtss_f32(_mm_shuffle_ps(dz, dz, 1)), c_kz = _mm_cvtss_f32(_mm_movehl_ps(dz, dz));
+    const float depth = std::max(std::max(a_kz, b_kz), c_kz) - std::min(std::min(a_kz, b_kz), c_kz);
+    if (ill_conditioned(lateral, depth, det)) [[unlikely]] return intersect_unbounded_rare(r, tri, t, u, v);
+    return true;
 }
 #endif
 

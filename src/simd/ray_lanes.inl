@@ -20,12 +20,12 @@ inline I det_in_range_lanes(F det) {
 // lane's ray's kx, ky or kz axis (role 0, 1, 2), read where it is used; (ox, oy, oz) the ray's origin
 // on those axes and (sx, sy, sz) its shear. Each lane runs the scalar test's operations in their
 // order, so t, u and v carry its bits; an edge function of exactly zero (a ray through an edge or a
-// vertex) is recomputed in double precision as the scalar test does. Returns the lanes of `used`
-// whose ray meets its triangle; t's finiteness is left to the callers' bounds, which are finite
-// floats (kernel/traversal.hpp). The lanes by reference, read where they are used: taken by value,
-// they were all loaded before the test and the AVX2 kernels spilled. One copy for the kd-tree's and the BIH's packets
-// (packet_kernels.inl), the wide BVH's leaves (bvh_kernels.inl) and its packets' leaves
-// (bvh_packet.inl).
+// vertex) is recomputed in double precision as the scalar test does, and so is the t of an
+// ill-conditioned hit. Returns the lanes of `used` whose ray meets its triangle; t's finiteness is
+// left to the callers' bounds, which are finite floats (kernel/traversal.hpp). The lanes by
+// reference, read where they are used: taken by value, they were all loaded before the test and the
+// AVX2 kernels spilled. One copy for the kd-tree's and the BIH's packets (packet_kernels.inl), the
+// wide BVH's leaves (bvh_kernels.inl) and its packets' leaves (bvh_packet.inl).
 template <class Coord>
 [[gnu::always_inline]] inline I watertight_in_lanes(Coord&& coord, const F& ox, const F& oy, const F& oz, const F& sx,
                                                     const F& sy, const F& sz, const I& used, F& t, F& u, F& v) {
@@ -40,9 +40,9 @@ template <class Coord>
     if (any(zero)) {
         for (int i = 0; i < kLanes; ++i) {
             if (zero[i] == 0) continue;
-            eu[i] = static_cast<float>(double(cx[i]) * double(by[i]) - double(cy[i]) * double(bx[i]));
-            ev[i] = static_cast<float>(double(ax[i]) * double(cy[i]) - double(ay[i]) * double(cx[i]));
-            ew[i] = static_cast<float>(double(bx[i]) * double(ay[i]) - double(by[i]) * double(ax[i]));
+            eu[i] = edge_in_double(cx[i], by[i], cy[i], bx[i]);
+            ev[i] = edge_in_double(ax[i], cy[i], ay[i], cx[i]);
+            ew[i] = edge_in_double(bx[i], ay[i], by[i], ax[i]);
         }
     }
     const I negative = (eu < 0.f) | (ev < 0.f) | (ew < 0.f);
@@ -54,7 +54,30 @@ template <class Coord>
     t = big_t * inv_det;
     u = ev * inv_det;
     v = ew * inv_det;
-    return used & ~(negative & positive) & det_in_range_lanes(det);
+    I hit = used & ~(negative & positive) & det_in_range_lanes(det);
+    // Ill-conditioned hits with a finite t (triangle.hpp, ill_conditioned): t taken again in double
+    // precision, lane by lane, as the scalar test does; only where some lane hits.
+    if (any(hit)) {
+        const F lateral = max_lanes(max_lanes(max_lanes(abs_lanes(ax), abs_lanes(bx)), abs_lanes(cx)),
+                                    max_lanes(max_lanes(abs_lanes(ay), abs_lanes(by)), abs_lanes(cy)));
+        const F depth = max_lanes(max_lanes(a_kz, b_kz), c_kz) - min_lanes(min_lanes(a_kz, b_kz), c_kz);
+        const I ill = hit & (abs_lanes(t) < splat(kInfinity)) & (lateral * depth > splat(kIllConditioned) * abs_lanes(det));
+        if (any(ill)) [[unlikely]] {
+            for (int i = 0; i < kLanes; ++i) {
+                if (ill[i] == 0) continue;
+                float x[3], y[3], z[3];
+                for (int k = 0; k < 3; ++k) {
+                    x[k] = coord(k, 0)[i];
+                    y[k] = coord(k, 1)[i];
+                    z[k] = coord(k, 2)[i];
+                }
+                float refined = t[i];
+                if (refined_t(x, y, z, ox[i], oy[i], oz[i], sx[i], sy[i], sz[i], refined)) t[i] = refined;
+                else hit[i] = 0;
+            }
+        }
+    }
+    return hit;
 }
 
 // TraversalRay's set-up of rays [0, n) of a batch (n <= kLanes), tnear and tfar clamped to the

@@ -74,6 +74,53 @@ def test_bvh_traversals(case):
         assert np.array_equal(acc.occluded(*rays), occluded)
 
 
+# A thin triangle seen at a grazing angle, a small triangle across the ray just behind where the
+# float test used to put the hit, and a cloud of tiny triangles around that point to make the
+# trees cut there (audit, 2026-12-07): the crossing with the thin triangle's plane, which the test
+# took, lay off the triangle, and the kd-tree (1: 1 long, 1e-3 wide) and the BVH's spatial splits
+# (2: 2.8e-4 wide, 2.4e-7 rad), whose cells and boxes hold clipped parts of it, missed that hit.
+GRAZING = [
+    ([[0.31996285915374756, 0.5216338038444519, 0.965959906578064],
+      [0.6800371408462524, 0.4783662259578705, 0.034040119498968124],
+      [0.6808173656463623, 0.4778325855731964, 0.03436636924743652]],
+     [-0.35135218501091003, 1.1609665155410767, -0.2756071388721466],
+     [0.7802489995956421, -0.5336419343948364, 0.32624801993370056], 1.264935, 1, 1.7e-3, 2e-5, 5e-5, 0.001),
+    ([[0.8049867749214172, 0.7365383505821228, 0.18214364349842072],
+      [0.19501322507858276, 0.2634616196155548, 0.8178563714027405],
+      [0.19522954523563385, 0.2634125351905823, 0.8180273771286011]],
+     [1.201639175415039, 0.3552662134170532, 1.0283280611038208],
+     [-0.7722904086112976, 0.17522260546684265, -0.6106263995170593], 0.88926196, 2, 0.3, 1e-3, 4e-3, 6e-5),
+]
+
+
+@pytest.mark.parametrize("sliver, origin, direction, t_old, seed, spread, size, clear, behind", GRAZING)
+def test_grazing_slivers_are_found_by_every_kind(sliver, origin, direction, t_old, seed, spread, size, clear, behind):
+    o = np.array([origin], np.float32)
+    d = np.array([direction], np.float32)
+    o0, d0 = o[0].astype(float), d[0].astype(float)
+    rng = np.random.default_rng(seed)
+    c = o0 + t_old * d0 + rng.uniform(-spread, spread, (3000, 3))
+    u = d0 / np.linalg.norm(d0)
+    rel = c - o0
+    c = c[np.linalg.norm(rel - np.outer(rel @ u, u), axis=1) > clear]
+    cloud = c[:, None, :] + rng.uniform(-size, size, (len(c), 3, 3))
+    p = np.cross(u, [0, 0, 1])
+    p /= np.linalg.norm(p)
+    q = np.cross(u, p)
+    blocker = o0 + (t_old + behind) * d0 + 1e-4 * np.array([p, -p + q, -p - q])
+    tris = np.concatenate([np.array(sliver)[None], blocker[None], cloud]).astype(np.float32)
+    brute = cellrt.Accelerator(tris, kind="brute", simd="off")
+    hit = brute.intersect(o, d)
+    t = hit["t"][0]
+    assert np.isfinite(t)
+    for kind in KINDS + [None]:
+        for simd in ("off", "auto"):
+            acc = cellrt.Accelerator(tris, kind=kind, simd=simd)
+            assert_same_hits(acc.intersect(o, d), hit)
+            assert acc.occluded(o, d, 0.0, t)[0], acc.config
+            assert acc.intersect(o, d, t, t)["prim"][0] == hit["prim"][0], acc.config
+
+
 def test_indexed_mesh_equals_triangle_soup(city):
     tris = np.asarray(city.triangles)
     vertices, faces = np.unique(tris.reshape(-1, 3), axis=0, return_inverse=True)
