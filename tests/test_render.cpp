@@ -393,6 +393,21 @@ TEST(ImageSize, ParsedStrictlyAndLimitedBeforeAllocation) {
               path + ": image size 100000x100000 must have both sides in [1, 65536]");
     std::ofstream(path, std::ios::binary) << "PF\n99999999999 2\n-1.0\n";
     EXPECT_EQ(error_of([&] { read_pfm(path); }), path + ": not a little-endian RGB PFM file");
+
+    // Written images pass the same check, and hold the pixels their size says: an empty image made a
+    // PFM read_pfm refused and a PNG of no pixels; one whose pixels were missing was read past.
+    const std::string out = (dir / "out.pfm").string(), png = (dir / "out.png").string();
+    EXPECT_EQ(error_of([&] { write_image(Image(), out, false); }),
+              out + ": image size 0x0 must have both sides in [1, 65536]");
+    EXPECT_EQ(error_of([&] { write_png(Srgb8Image(), png, false); }),
+              png + ": image size 0x0 must have both sides in [1, 65536]");
+    Image missing;
+    missing.width = missing.height = 4;
+    EXPECT_EQ(error_of([&] { write_image(missing, png, false); }), png + ": the image is 4x4 but holds 0 pixels");
+    Srgb8Image short_rows(2, 2);
+    short_rows.height = 3;
+    EXPECT_EQ(error_of([&] { write_png(short_rows, png, false); }), png + ": the image is 2x3 but holds 4 pixels");
+    EXPECT_FALSE(std::filesystem::exists(out) || std::filesystem::exists(png));
     std::filesystem::remove_all(dir);
 }
 

@@ -25,7 +25,8 @@ struct Image {
 // Writes by extension: .png (sRGB-encoded, clamped) or .pfm (little-endian float RGB). The file is
 // written beside the target under a temporary name and renamed into place, so an interrupted write
 // never leaves a partial file under `path`. Refuses to replace an existing file unless `overwrite`.
-// Throws cellrt::Error naming the path on any failure.
+// Throws cellrt::Error naming the path on any failure, and for an image whose size check_image_size
+// refuses (no pixels) or whose pixels are not width x height.
 void write_image(const Image& image, const std::string& path, bool overwrite);
 
 // A frame as a PNG holds it: 8-bit sRGB, three bytes a pixel (red, green, blue), row-major, row 0 at
@@ -49,7 +50,7 @@ Srgb8Image to_srgb8(const Image& image);
 
 // Writes a PNG of 8-bit pixels, as write_image does (atomically; `overwrite` as there): for the pixels
 // of to_srgb8(image) the very bytes of write_image(image) to a .png path. Throws cellrt::Error naming
-// the path on any failure, or when the path does not end in .png.
+// the path on any failure, when the path does not end in .png, and for an image write_image refuses.
 void write_png(const Srgb8Image& image, const std::string& path, bool overwrite);
 
 // Reads a PFM written by write_image (for tests and comparisons).

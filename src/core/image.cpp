@@ -113,13 +113,32 @@ Srgb8Image to_srgb8(const Image& image) {
     return out;
 }
 
+namespace {
+
+// An image's size within the limits and its pixels as many as it says: an empty image made a file
+// read_pfm refuses (and an empty PNG), a size its pixels did not match read past them.
+void check_pixels(const std::string& path, int width, int height, std::size_t values, std::size_t per_pixel) {
+    try {
+        check_image_size(width, height);
+    } catch (const Error& e) {
+        throw Error(path + ": " + e.what());
+    }
+    if (values != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * per_pixel)
+        throw Error(path + ": the image is " + std::to_string(width) + "x" + std::to_string(height) + " but holds " +
+                    std::to_string(values / per_pixel) + " pixels");
+}
+
+}  // namespace
+
 void write_png(const Srgb8Image& image, const std::string& path, bool overwrite) {
     if (lower_extension(path) != ".png") throw Error(path + ": 8-bit pixels are written as .png only");
+    check_pixels(path, image.width, image.height, image.rgb.size(), 3);
     write_file_atomically(path, encode_png(image), overwrite);
 }
 
 void write_image(const Image& image, const std::string& path, bool overwrite) {
     const std::string ext = lower_extension(path);
+    check_pixels(path, image.width, image.height, image.pixels.size(), 1);
     std::string bytes;
     if (ext == ".png") bytes = encode_png(to_srgb8(image));
     else if (ext == ".pfm") bytes = encode_pfm(image);
