@@ -229,6 +229,26 @@ TEST(Schedule, APacketThatThrowsEndsTheFrameWithItsException) {
             }
 }
 
+// So does a progress callback that throws: under mailbox dispatch its master used to leave the
+// workers polling for ever.
+TEST(Schedule, AProgressCallbackThatThrowsEndsTheFrameWithItsException) {
+    const PacketGrid grid(64, 64, 4);
+    for (const Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        for (const unsigned workers : {1u, 2u, 4u}) {
+            ScheduleOptions o;
+            o.dispatch = d;
+            o.workers = workers;
+            o.progress = [](std::size_t done, std::size_t) {
+                if (done == 2) throw Error("stop");
+            };
+            Image image(64, 64);
+            const PacketTracer fill = [](unsigned, const PixelRect&, std::span<Vec3> c) { std::fill(c.begin(), c.end(), Vec3(1.f)); };
+            EXPECT_EQ(test::error_of([&] { run_packets(grid, o, image, fill); }), "stop") << to_string(d) << ", " << workers;
+            o.progress = nullptr;
+            EXPECT_TRUE(run_packets(grid, o, image, fill)) << to_string(d) << ", " << workers;
+        }
+}
+
 // The team behind both dispatch modes: every job index runs once per run, all at the same time (a
 // job that waits for all the others would hang otherwise), job 0 on the calling thread and job j on
 // the same thread from run to run, and a larger run after a smaller one grows the team; whether the

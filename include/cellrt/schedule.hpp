@@ -69,7 +69,8 @@ struct ScheduleOptions {
     // drawn back to back do not pay a wake-up per worker (0: sleep at once; docs/SCALING.md).
     std::chrono::microseconds idle_spin{kDefaultIdleSpin};
     const std::atomic<bool>* cancel = nullptr;
-    std::function<void(std::size_t, std::size_t)> progress;  // (packets done, packets in all)
+    // (packets done, packets in all). An exception it throws ends the frame as a packet's does.
+    std::function<void(std::size_t, std::size_t)> progress;
 };
 
 // Computes the colours of one packet (row-major over rect, rect.pixels() entries) on worker `worker`.

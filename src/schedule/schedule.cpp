@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -141,11 +142,11 @@ bool run_pull(const PacketGrid& grid, const ScheduleOptions& options, Image& ima
                     trace(w, r, out);
                     store(image, r, out);
                 });
+                if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, count);
             } catch (...) {
                 failed.store(true, std::memory_order_relaxed);
                 throw;
             }
-            if (options.progress) options.progress(done.fetch_add(1, std::memory_order_relaxed) + 1, count);
         }
         load.finished_seconds = frame.seconds();
     };
@@ -201,9 +202,12 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
     };
     // The master (the study's PPU), on the calling thread: keeps the packet counter, posts each packet
     // to an idle worker, and writes every finished packet's colours into the frame buffer.
-    // After a worker's packet threw, no packet is posted; the ones in flight are awaited.
+    // After a worker's packet threw, no packet is posted; the ones in flight are awaited. So after the
+    // progress callback threw on the master: it left the workers polling for ever once (found by audit,
+    // 2026-12-07), and a worker still tracing would have overwritten a stop with its `done`.
     std::size_t next = 0, done = 0, in_flight = 0;
     bool failed = false;
+    std::exception_ptr progress_failure;
     auto master = [&] {
         for (;;) {
             const bool more = next < grid.count() && !cancelled(options) && !failed;
@@ -222,7 +226,14 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
                     --in_flight;
                     ++done;
                     progressed = true;
-                    if (options.progress) options.progress(done, grid.count());
+                    if (options.progress && !failed) {
+                        try {
+                            options.progress(done, grid.count());
+                        } catch (...) {
+                            progress_failure = std::current_exception();
+                            failed = true;
+                        }
+                    }
                 }
                 if (b.state.load(std::memory_order_relaxed) == Mailbox::idle && next < grid.count() &&
                     !cancelled(options) && !failed) {
@@ -235,6 +246,7 @@ bool run_mailbox(const PacketGrid& grid, const ScheduleOptions& options, Image& 
             if (!progressed) std::this_thread::yield();
         }
         for (Mailbox& b : boxes) b.state.store(Mailbox::stop, std::memory_order_release);
+        if (progress_failure) std::rethrow_exception(progress_failure);
     };
     // Job 0 (the calling thread) is the master, job i + 1 worker i: the master has a core of its own
     // when there are cores to spare, as the PPU was a core of its own.
