@@ -138,18 +138,28 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {kSquareVertices + "f 0 1 2\n", ":5: face index 0 is invalid (OBJ indices start at 1)"},
         {kSquareVertices + "f 1 2 3\nf 1 2 6\nv 0 0 1\n", ":6: face index 6 is out of range (the file has 5 vertices)"},
         {kSquareVertices + "f 1 2 3\r\nf 2 3 9\r\n", ":6: face index 9 is out of range (the file has 4 vertices)"},
-        {kSquareVertices + "f -5 -2 -1\nv 0 0 1\n", ":5: face index -5 is out of range (the file has 5 vertices)"},
+        {kSquareVertices + "f -5 -2 -1\nv 0 0 1\n", ":5: face index -5 is out of range (4 vertices before it)"},
         {kSquareVertices + "f 1 2 99999999999999999999\n", ":5: face index 99999999999999999999 is out of range"},
         {kSquareVertices + "f -99999999999999999999/1 1 2\n", ":5: face index -99999999999999999999 is out of range"},
         {kSquareVertices + "f 1 2 9223372036854775807\n",
          ":5: face index 9223372036854775807 is out of range (the file has 4 vertices)"},
         {kSquareVertices + "f -9223372036854775808 1 2\n",
-         ":5: face index -9223372036854775808 is out of range (the file has 4 vertices)"},
+         ":5: face index -9223372036854775808 is out of range (4 vertices before it)"},
     };
     for (const Case& c : cases) {
         const std::string path = write("bad.obj", c.text);
         EXPECT_EQ(error_of([&] { load_obj(path); }), path + c.message) << c.text;
     }
+}
+
+// A UTF-8 byte-order mark before the first line is skipped: it used to hide the first vertex, and
+// every face then named the vertex after the one it meant, without a word.
+TEST_F(LoaderTest, ObjByteOrderMarkIsSkipped) {
+    const std::string plain = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nf 1 2 3\n";
+    const std::vector<Triangle> expected = load_obj(write("plain.obj", plain));
+    ASSERT_EQ(expected.size(), 1u);
+    EXPECT_EQ(expected[0].v0, Vec3(0.f, 0.f, 0.f));
+    EXPECT_EQ(load_obj(write("bom.obj", "\xEF\xBB\xBF" + plain)), expected);
 }
 
 TEST_F(LoaderTest, MissingFileIsNamed) {
@@ -769,6 +779,11 @@ TEST_F(LoaderTest, ViewFileRejectsWrongTypes) {
         // Finite doubles beyond float's range: infinite once read as floats.
         {[](json& d) { d["light"]["position"] = {0, 1e39, 0}; }, "the light position is not finite"},
         {[](json& d) { d["light"]["color"] = {1e39, 1, 1}; }, "the light color is not finite"},
+        // Found by audit (2026-12-07): accepted, a name of the wrong type replaced by the file's, and
+        // a negative colour shading pixels below zero.
+        {[](json& d) { d["light"]["color"] = {1, -1, 1}; }, "the light color has a negative channel"},
+        {[](json& d) { d["name"] = 5; }, "field 'name' must be a string"},
+        {[](json& d) { d["name"] = nullptr; }, "field 'name' must be a string"},
     };
     for (const Case& c : cases) {
         json doc = view_doc();

@@ -24,6 +24,9 @@ public:
     explicit ObjParser(const std::string& path) : path_(path) {}
 
     std::vector<Triangle> parse(std::string_view text) {
+        // A UTF-8 byte-order mark, as some Windows editors write, would make the first line's keyword
+        // unknown and skip it: a first vertex lost shifted every index by one (found by audit, 2026-12-07).
+        if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
         std::size_t line_no = 0;
         while (!text.empty()) {
             const std::size_t nl = text.find('\n');
@@ -114,9 +117,12 @@ private:
             auto vertex = [&](std::size_t k) -> const Vec3& {
                 const Corner& c = corners_[f.first + k];
                 const std::int64_t i = c.index > 0 ? c.index - 1 : static_cast<std::int64_t>(c.vertices_before) + c.index;
+                // A negative index counts back from the vertices before its line, not the file's.
                 if (i < 0 || i >= static_cast<std::int64_t>(vertices_.size()))
-                    fail("face index " + std::to_string(c.index) + " is out of range (the file has " +
-                             std::to_string(vertices_.size()) + " vertices)",
+                    fail("face index " + std::to_string(c.index) + " is out of range (" +
+                             (c.index < 0 ? std::to_string(c.vertices_before) + " vertices before it"
+                                          : "the file has " + std::to_string(vertices_.size()) + " vertices") +
+                             ")",
                          f.line);
                 return vertices_[static_cast<std::size_t>(i)];
             };

@@ -68,6 +68,9 @@ void validate_scene(const Scene& scene, const std::string& where) {
         if (!is_finite(scene.light.position)) throw Error("the light position is not finite");
         // A colour past float's range (1e39 in a view file) would shade pixels infinite.
         if (!is_finite(scene.light.color)) throw Error("the light color is not finite");
+        // Light is added, never taken away: a negative channel shaded pixels below zero.
+        if (scene.light.color.x < 0.f || scene.light.color.y < 0.f || scene.light.color.z < 0.f)
+            throw Error("the light color has a negative channel");
         PinholeCamera(scene.camera, scene.width, scene.height);
     } catch (const Error& e) {
         throw Error(where + ": " + e.what());

@@ -160,9 +160,9 @@ public:
             fail("mesh", "names " + mesh_path.string() + ", which is a folder, not a file");
 
         Scene scene;
-        scene.name = doc.contains("name") && doc["name"].is_string()
-                         ? doc["name"].get<std::string>()
-                         : std::filesystem::path(path_).stem().string();
+        // Of the right type, as every other field: a name of 5 or null used to give way to the file's.
+        if (doc.contains("name") && !doc["name"].is_string()) fail("name", "must be a string");
+        scene.name = doc.contains("name") ? doc["name"].get<std::string>() : std::filesystem::path(path_).stem().string();
         const json& cam = field(doc, "", "camera");
         only(cam, "camera", {"position", "look_at", "up", "fov_y_deg"});
         scene.camera.position = vec3(cam, "camera", "position");
