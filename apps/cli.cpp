@@ -159,8 +159,13 @@ void print_stats(const AccelStats& s) {
 
 Progress::Progress() : enabled_(::isatty(STDERR_FILENO)) {}
 
-Progress::~Progress() {
+Progress::~Progress() { finish(); }
+
+void Progress::finish() {
+    std::lock_guard lock(mutex_);
     if (shown_) std::fprintf(stderr, "\n");
+    shown_ = false;
+    enabled_ = false;
 }
 
 void Progress::operator()(std::size_t done, std::size_t total) {

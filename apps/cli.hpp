@@ -89,6 +89,9 @@ public:
     Progress();
     ~Progress();
     void operator()(std::size_t done, std::size_t total);
+    // Ends the bar's line, where one was drawn: before what the program prints next (the summary
+    // used to follow the bar on its line).
+    void finish();
 
 private:
     bool enabled_;

@@ -271,7 +271,10 @@ nlohmann::json profile_json(const Scene& scene, const ProfileOptions& o, const P
 int run_profile(const ProfileOptions& o) {
     Profile p;
     p.hardware = use_hardware_counters(o.method);
-    if (!o.json.empty()) check_output_file(o.json, o.overwrite);
+    if (!o.json.empty()) {
+        check_output_file(o.json, o.overwrite);
+        check_distinct_files({{"--json", o.json}}, {{"scene", o.scene}});
+    }
     if (o.packet < 1 || o.packet > kMaxPacket)
         throw Error("--packet " + std::to_string(o.packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
     p.config = profiled_config(o.accel, p.hardware);

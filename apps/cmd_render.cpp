@@ -254,7 +254,12 @@ Runner add_render(CLI::App& app) {
         Timer frame_timer;
         cluster::render(scene, accel, ro, lower_extension(o->out) == ".png", frame, rs, ranks_report);
         const double frame_s = frame_timer.seconds();
+        progress.finish();
         if (!cluster::leader()) return 0;
+        // Ctrl-C after the last packet, while the frame was gathered, still ends the run with no file
+        // (found by audit, 2026-12-07: it was ignored). One during the write itself is seen after it:
+        // the file is then whole.
+        if (g_cancel) throw Error("render cancelled");
         if (const Image* image = std::get_if<Image>(&frame)) write_image(*image, o->out, o->overwrite);
         else write_png(std::get<Srgb8Image>(frame), o->out, o->overwrite);
         const AccelStats st = accel.stats();

@@ -288,6 +288,9 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"render", spheres, "-o", out, "--stats", folder_obj}, folder_obj + ": is a folder, not a file"},
         {{"render", good_view, "-o", out, "--stats", good_view, "--overwrite"},
          "--stats " + good_view + " names the scene " + good_view + ", which it would replace"},
+        // And profile --json did replace it (found by audit, 2026-12-07).
+        {{"profile", good_view, "--json", good_view, "--overwrite"},
+         "--json " + good_view + " names the scene " + good_view + ", which it would replace"},
         {{"cache-study", (dir.path / "missing.obj").string(), "--out", study},
          (dir.path / "missing.obj").string() + ": no such file"},
         // Integers in decimal digits only: CLI11 read `010` as 8, `0x2` as 2, " 4" as 4 and "" as 0
