@@ -198,6 +198,15 @@ py::array_t<bool> py_occluded(const PyAccelerator& a, py::handle origins, py::ha
 
 py::tuple vec_tuple(const Vec3& v) { return py::make_tuple(v.x, v.y, v.z); }
 
+// A property's value that must be an object of the class `type` (its Python name): pybind11's own
+// refusal was a TypeError naming no property ("(): incompatible function arguments").
+template <class T>
+T instance_of(py::handle value, const char* name, const char* type) {
+    if (!py::isinstance<T>(value))
+        throw py::value_error(std::string(name) + " must be a " + type + ", got " + py::repr(value).cast<std::string>());
+    return value.cast<T>();
+}
+
 // A Vec3 member as a property of three floats, set from any sequence of three finite numbers.
 template <class C>
 void vec_property(py::class_<C>& cls, const char* name, Vec3 C::*member, const char* doc) {
@@ -305,6 +314,8 @@ PYBIND11_MODULE(cellrt, m) {
     m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
     m.attr("__version__") = CELLRT_VERSION_STRING;
     static const py::exception<Error>& error_type = py::register_exception<Error>(m, "Error", PyExc_ValueError);
+    error_type.attr("__doc__") = "What the library refuses (a file, a configuration, a camera), with its message naming "
+                                 "the file and line, the field or the parameter at fault; a ValueError.";
     // The library's messages name files in the bytes the system gave, which need not be UTF-8: decoded
     // strictly (pybind11's own translator) such a message came out empty. Bytes that are not UTF-8
     // read as \xff escapes. Registered after register_exception's translator, so tried before it.
@@ -321,26 +332,27 @@ PYBIND11_MODULE(cellrt, m) {
     });
 
     py::class_<TreeReport>(m, "TreeReport", "A tree's build report: its shape, references per triangle, SAH cost")
-        .def_readonly("nodes", &TreeReport::nodes)
-        .def_readonly("inner_nodes", &TreeReport::inner_nodes)
-        .def_readonly("leaves", &TreeReport::leaves)
-        .def_readonly("empty_leaves", &TreeReport::empty_leaves)
+        .def_readonly("nodes", &TreeReport::nodes, "inner nodes and leaves")
+        .def_readonly("inner_nodes", &TreeReport::inner_nodes, "nodes with children")
+        .def_readonly("leaves", &TreeReport::leaves, "nodes holding triangle references")
+        .def_readonly("empty_leaves", &TreeReport::empty_leaves, "leaves of no triangle")
         .def_readonly("empty_space_nodes", &TreeReport::empty_space_nodes, "BIH: inner nodes cutting off empty space")
         .def_readonly("depth_limit", &TreeReport::depth_limit, "0: none")
-        .def_readonly("max_depth", &TreeReport::max_depth)
-        .def_readonly("mean_leaf_depth", &TreeReport::mean_leaf_depth)
-        .def_readonly("triangles_per_leaf", &TreeReport::triangles_per_leaf)
-        .def_readonly("references_per_triangle", &TreeReport::references_per_triangle)
-        .def_readonly("sah_cost", &TreeReport::sah_cost);
+        .def_readonly("max_depth", &TreeReport::max_depth, "the deepest leaf's depth (the root: 0)")
+        .def_readonly("mean_leaf_depth", &TreeReport::mean_leaf_depth, "over the non-empty leaves")
+        .def_readonly("triangles_per_leaf", &TreeReport::triangles_per_leaf, "references per non-empty leaf")
+        .def_readonly("references_per_triangle", &TreeReport::references_per_triangle,
+                      "leaf references over triangles (above 1 where triangles straddle splits)")
+        .def_readonly("sah_cost", &TreeReport::sah_cost, "the expected cost of a ray through the root, in the builder's units");
 
     py::class_<AccelStats>(m, "AccelStats", "What a built accelerator reports (cellrt/accelerator.hpp)")
         .def_readonly("name", &AccelStats::name, "the kind")
         .def_readonly("traversal", &AccelStats::traversal, "the single-ray kernel, 'packet' (SIMD packets), or Embree's")
         .def_readonly("simd_lanes", &AccelStats::simd_lanes, "rays a SIMD packet traces at once; 0: single rays")
-        .def_readonly("build_seconds", &AccelStats::build_seconds)
-        .def_readonly("memory_bytes", &AccelStats::memory_bytes)
-        .def_readonly("triangles", &AccelStats::triangles)
-        .def_readonly("tree", &AccelStats::tree, "TreeReport (kd-tree, BIH) or None")
+        .def_readonly("build_seconds", &AccelStats::build_seconds, "the build's wall-clock time")
+        .def_readonly("memory_bytes", &AccelStats::memory_bytes, "the structure's memory, triangles included")
+        .def_readonly("triangles", &AccelStats::triangles, "the triangles it was built over")
+        .def_readonly("tree", &AccelStats::tree, "TreeReport (kd-tree, BIH, BVH) or None")
         .def_property_readonly(
             "settings",
             [](const AccelStats& s) {
@@ -441,7 +453,7 @@ PYBIND11_MODULE(cellrt, m) {
              py::arg("triangles"), "Scene(triangles (M,3,3)): framed by the default view of a bare mesh")
         .def_property(
             "name", [](const Scene& s) { return decoded(s.name); },
-            [](Scene& s, py::handle value) { s.name = text(value, "name", true); })
+            [](Scene& s, py::handle value) { s.name = text(value, "name", true); }, "the scene's name (str)")
         .def_property_readonly(
             "triangles",
             [](py::object self) {
@@ -453,8 +465,14 @@ PYBIND11_MODULE(cellrt, m) {
                 return a;
             },
             "(M, 3, 3) float32, a read-only view of the scene's own triangles")
-        .def_readwrite("camera", &Scene::camera)
-        .def_readwrite("light", &Scene::light)
+        .def_property(
+            "camera", py::cpp_function([](Scene& s) -> Camera& { return s.camera; }, py::return_value_policy::reference_internal),
+            [](Scene& s, py::handle value) { s.camera = instance_of<Camera>(value, "camera", "cellrt.Camera"); },
+            "the view, a cellrt.Camera: a live view of the scene's; assigning one copies it in")
+        .def_property(
+            "light", py::cpp_function([](Scene& s) -> PointLight& { return s.light; }, py::return_value_policy::reference_internal),
+            [](Scene& s, py::handle value) { s.light = instance_of<PointLight>(value, "light", "cellrt.Light"); },
+            "the point light, a cellrt.Light: a live view of the scene's; assigning one copies it in")
         .def_property(
             "size", [](const Scene& s) { return py::make_tuple(s.width, s.height); },
             [](Scene& s, py::handle size) { std::tie(s.width, s.height) = image_size(size); }, "(width, height)")

@@ -326,6 +326,15 @@ def test_bad_scene_properties():
     with pytest.raises(ValueError):
         scene.triangles[0, 0, 0] = 5.0
     refused(r"width must be an integer in \[1, 65536\], got 0", scene.camera.rays, 0, 4)
+    # A camera and a light are set whole, from their own classes: anything else was pybind11's
+    # TypeError, which named no property. The camera stays a live view of the scene's.
+    for value in (None, 5, cellrt.Light()):
+        refused(r"camera must be a cellrt.Camera, got ", setattr, scene, "camera", value)
+    refused(r"light must be a cellrt.Light, got ", setattr, scene, "light", cellrt.Camera())
+    camera.fov_y_deg = 45
+    scene.camera = camera
+    scene.camera.fov_y_deg = 50
+    assert (scene.camera.fov_y_deg, camera.fov_y_deg) == (50.0, 45.0)
 
 
 def test_a_missing_gpu_is_a_library_error_naming_why():
