@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Rewrites the parameter tables of docs/KDTREE.md, docs/BIH.md, docs/BVH.md and docs/EMBREE.md from the tables
 that validate the parameters, as `cellrt info --params KIND` prints them (the test
-Params.DocumentsPrintTheTablesThatValidate fails until they agree).
+Params.DocumentsPrintTheTablesThatValidate fails until they agree). That test also compares the
+`<!-- params:cuda -->` table of docs/GPU.md with the CUDA backend's memory parameters
+(detail::device_memory_params(), src/cuda/device_memory.cpp), which `cellrt info --params` cannot
+print: this script leaves that table alone; it is kept by hand.
 
     tools/param_docs.py [BUILD]      # BUILD: the build folder, build/ by default
 """
