@@ -218,14 +218,30 @@ Real distance_to(const Triangle& tri, const R3& p) {
     return Real(std::sqrt(static_cast<long double>(dot3(q, q))));
 }
 
-// How far from the triangle a hit at t lies, over the triangle's largest offset from the origin.
-Real relative_miss(const Triangle& tri, const Ray& ray, float t) {
+// The triangle's largest offset from the ray's origin.
+Real widest_offset(const Triangle& tri, const Ray& ray) {
     Real widest = 0;
     for (const Vec3& v : {tri.v0, tri.v1, tri.v2})
         for (int axis = 0; axis < 3; ++axis) widest = std::max(widest, Real(std::fabs(double(v[axis]) - ray.org[axis])));
+    return widest;
+}
+
+// How far from the triangle a hit at t lies, over the triangle's largest offset from the origin.
+Real relative_miss(const Triangle& tri, const Ray& ray, float t) {
     R3 p;
     for (int axis = 0; axis < 3; ++axis) p[axis] = Real(ray.org[axis]) + Real(t) * ray.dir[axis];
-    return distance_to(tri, p) / widest;
+    return distance_to(tri, p) / widest_offset(tri, ray);
+}
+
+// How far the point the barycentrics name lies from the point at t, over the same.
+Real relative_uv_gap(const Triangle& tri, const Ray& ray, float t, float u, float v) {
+    Real gap2 = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const Real named = (1 - Real(u) - Real(v)) * tri.v0[axis] + Real(u) * tri.v1[axis] + Real(v) * tri.v2[axis];
+        const Real d = named - (Real(ray.org[axis]) + Real(t) * ray.dir[axis]);
+        gap2 += d * d;
+    }
+    return Real(std::sqrt(static_cast<long double>(gap2))) / widest_offset(tri, ray);
 }
 
 // A triangle of exactly zero area (collinear vertices) that the shear's rounding gave a determinant:
@@ -267,7 +283,8 @@ TEST(Watertight, ATJunctionClosedByAZeroAreaTriangleDoesNotLeak) {
 // test's t strayed along a sliver, up to 0.3 % of the distance, and the crossing of a grazing ray with
 // the plane lay 0.25 off a triangle 1 long. kd-trees, BIHs and the BVH's spatial splits culled hits
 // brute force took (audit, 2026-12-07). Every hit now lies on its triangle, to 2^-18 of the
-// largest offset from the origin (a quarter of the least margin).
+// largest offset from the origin (a quarter of the least margin), and its barycentrics name it
+// (they named the float test's point, off the ray, found by review).
 TEST(Watertight, IllConditionedHitsLieOnTheirTriangle) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u01(0.f, 1.f);
@@ -290,6 +307,10 @@ TEST(Watertight, IllConditionedHitsLieOnTheirTriangle) {
             ++hits;
             grazing += k % 2;
             EXPECT_LT(double(relative_miss(tri, ray, t)), 0x1p-18) << "sliver " << i << ", ray " << k;
+            // The barycentrics name that point too (the renderer's shading starts there), to the
+            // float test's error where it was kept, amplified up to kIllConditioned times (2.5e-5 of
+            // the offset seen here); the float test's point on a grazing ray lay 0.25 off, 1e-1.
+            EXPECT_LT(double(relative_uv_gap(tri, ray, t, bu, bv)), 0x1p-12) << "sliver " << i << ", ray " << k;
         }
     }
     EXPECT_GT(hits, 5000u);

@@ -16,6 +16,31 @@ inline I det_in_range_lanes(F det) {
     return (a >= splat(kLeastNormal)) & (a < splat(kInfinity));
 }
 
+// The lanes `lanes` (bit i: lane i) of an ill-conditioned hit, refined one by one (refined_t), as
+// the scalar test refines its hit; a lane whose refined t is not finite is no hit. Out of line, so
+// that the rare case does not crowd the test's registers.
+template <class Coord>
+[[gnu::noinline]] void refine_lanes(Coord coord, unsigned lanes, const F& ox, const F& oy, const F& oz, const F& sx,
+                                    const F& sy, const F& sz, F& t, F& u, F& v, I& hit) {
+    for (; lanes; lanes &= lanes - 1) {
+        const int i = __builtin_ctz(lanes);
+        float x[3], y[3], z[3];
+        for (int k = 0; k < 3; ++k) {
+            x[k] = coord(k, 0)[i];
+            y[k] = coord(k, 1)[i];
+            z[k] = coord(k, 2)[i];
+        }
+        float rt, ru, rv;
+        if (refined_t(x, y, z, ox[i], oy[i], oz[i], sx[i], sy[i], sz[i], rt, ru, rv)) {
+            t[i] = rt;
+            u[i] = ru;
+            v[i] = rv;
+        } else {
+            hit[i] = 0;
+        }
+    }
+}
+
 // The watertight test (triangle.hpp) in lanes: coord(k, role) gives vertex k's coordinate on each
 // lane's ray's kx, ky or kz axis (role 0, 1, 2), read where it is used; (ox, oy, oz) the ray's origin
 // on those axes and (sx, sy, sz) its shear. Each lane runs the scalar test's operations in their
@@ -55,27 +80,17 @@ template <class Coord>
     u = ev * inv_det;
     v = ew * inv_det;
     I hit = used & ~(negative & positive) & det_in_range_lanes(det);
-    // Ill-conditioned hits with a finite t (triangle.hpp, ill_conditioned): t taken again in double
-    // precision, lane by lane, as the scalar test does; only where some lane hits.
+    // Ill-conditioned hits with a finite t (triangle.hpp, ill_conditioned) are taken again as the
+    // scalar test takes them, out of line; only where some lane hits. The operands are not NaN in
+    // a lane that hits, where the maxima and minima are std::max's and std::min's.
     if (any(hit)) {
-        const F lateral = max_lanes(max_lanes(max_lanes(abs_lanes(ax), abs_lanes(bx)), abs_lanes(cx)),
-                                    max_lanes(max_lanes(abs_lanes(ay), abs_lanes(by)), abs_lanes(cy)));
-        const F depth = max_lanes(max_lanes(a_kz, b_kz), c_kz) - min_lanes(min_lanes(a_kz, b_kz), c_kz);
-        const I ill = hit & (abs_lanes(t) < splat(kInfinity)) & (lateral * depth > splat(kIllConditioned) * abs_lanes(det));
-        if (any(ill)) [[unlikely]] {
-            for (int i = 0; i < kLanes; ++i) {
-                if (ill[i] == 0) continue;
-                float x[3], y[3], z[3];
-                for (int k = 0; k < 3; ++k) {
-                    x[k] = coord(k, 0)[i];
-                    y[k] = coord(k, 1)[i];
-                    z[k] = coord(k, 2)[i];
-                }
-                float refined = t[i];
-                if (refined_t(x, y, z, ox[i], oy[i], oz[i], sx[i], sy[i], sz[i], refined)) t[i] = refined;
-                else hit[i] = 0;
-            }
-        }
+        const F lateral = lane_max_f(lane_max_f(lane_max_f(abs_lanes(ax), abs_lanes(bx)), abs_lanes(cx)),
+                                     lane_max_f(lane_max_f(abs_lanes(ay), abs_lanes(by)), abs_lanes(cy)));
+        const F depth = lane_max_f(lane_max_f(a_kz, b_kz), c_kz) - lane_min_f(lane_min_f(a_kz, b_kz), c_kz);
+        const I ill = hit & (abs_lanes(t) < splat(kInfinity)) &
+                      ((lateral * depth) * splat(1.f / kIllConditioned) > abs_lanes(det));
+        if (const unsigned lanes = bits(ill)) [[unlikely]]
+            refine_lanes(coord, lanes, ox, oy, oz, sx, sy, sz, t, u, v, hit);
     }
     return hit;
 }
