@@ -198,6 +198,21 @@ TEST(Workload, APixelsRaysDoNotDependOnThePacketSize) {
     }
 }
 
+// A zero-area triangle the test hits (rounding gave it an area) has no normal: the surface faces
+// the ray, and the shadow and bounce rays' origins are finite (the normal was NaN, and the origin's
+// offset converted NaN to an integer).
+TEST(Workload, AHitOnATriangleWithoutANormalFacesTheRay) {
+    const Triangle line{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {2.f, 0.f, 0.f}};
+    const Ray ray{{6.f, 1.5f, 0.0005f}, 0.f, {-4.5f, -1.5f, -0.0005f}, kInfinity};
+    Hit hit;
+    ASSERT_TRUE(intersect_closest(WatertightRay(ray), 0.f, line, 0u, hit));
+    const SurfacePoint sp = surface_point(line, ray, hit);
+    EXPECT_NEAR(length(sp.normal), 1.f, 1e-6f);
+    EXPECT_LT(dot(sp.normal, ray.dir), 0.f);
+    const Ray shadow = shadow_ray(sp.position, sp.normal, Vec3{0.f, 5.f, 5.f});
+    for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::isfinite(shadow.org[a]) && std::isfinite(shadow.dir[a]));
+}
+
 TEST(Workload, RefusesAnUnknownShadingAndAoSamplesOutOfRange) {
     EXPECT_EQ(parse_shading("ao"), Shading::ao);
     EXPECT_THROW(parse_shading("phong"), Error);

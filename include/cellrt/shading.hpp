@@ -54,13 +54,18 @@ struct PinholeProjection {
 };
 
 // The point a hit names and the triangle's geometric normal there, turned to face the side the ray
-// came from.
+// came from. A triangle whose normal has no direction in float (zero area: the test hits one where
+// rounding gives it an area, as at a T-junction; or a length that under- or overflows) faces the
+// ray: its normal was NaN, and the shadow ray's offset converted NaN to an integer (undefined;
+// found by review, 2026-12-07).
 struct SurfacePoint {
     Vec3 position, normal;
 };
 
 CELLRT_HD inline SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit) {
-    Vec3 n = normalize(tri.geometric_normal());
+    const Vec3 g = tri.geometric_normal();
+    const float len = length(g);
+    Vec3 n = len > 0.f && len < kInfinity ? g * (1.f / len) : -normalize(ray.dir);
     if (dot(n, ray.dir) > 0.f) n = -n;
     return {tri.v0 * (1.f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v, n};
 }
