@@ -432,7 +432,16 @@ PYBIND11_MODULE(cellrt, m) {
     py::class_<PointLight> light(m, "Light", "A point light: position, color");
     light.def(py::init<>());
     vec_property(light, "position", &PointLight::position, "(x, y, z)");
-    vec_property(light, "color", &PointLight::color, "(r, g, b)");
+    // Refused when set, as view files refuse it (validate_scene): light is added, never taken away.
+    light.def_property(
+        "color", [](const PointLight& l) { return vec_tuple(l.color); },
+        [](PointLight& l, py::handle value) {
+            const Vec3 c = vec3_value(value, "color");
+            if (c.x < 0.f || c.y < 0.f || c.z < 0.f)
+                throw py::value_error("color = " + py::repr(vec_tuple(c)).cast<std::string>() + " has a negative channel");
+            l.color = c;
+        },
+        "(r, g, b), each at least 0");
     refuse_second_init(camera);
     refuse_second_init(light);
 

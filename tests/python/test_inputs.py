@@ -314,6 +314,7 @@ def test_bad_scene_properties():
     refused(r"position must have shape \(3,\), got \(2,\)", setattr, scene.camera, "position", (1, 2))
     refused(r"up = \(0.0, nan, 0.0\) is not finite", setattr, scene.camera, "up", (0, np.nan, 0))
     refused("color must hold real numbers", setattr, scene.light, "color", ("r", "g", "b"))
+    refused(r"color = \(1.0, -1.0, 1.0\) has a negative channel", setattr, scene.light, "color", (1, -1, 1))
     refused(r"size\[1\] must be an integer", setattr, scene, "size", (5, 2.5))
     # The field of view is checked when set, as the vectors are, not first at render; 179.99999999
     # is 180 as a float32, the camera's type.
