@@ -200,7 +200,7 @@ TEST(Workload, APixelsRaysDoNotDependOnThePacketSize) {
 
 // A zero-area triangle the test hits (rounding gave it an area) has no normal: the surface faces
 // the ray, and the shadow and bounce rays' origins are finite (the normal was NaN, and the origin's
-// offset converted NaN to an integer).
+// offset converted NaN to an integer). Normals whose length leaves float's range keep their direction.
 TEST(Workload, AHitOnATriangleWithoutANormalFacesTheRay) {
     const Triangle line{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {2.f, 0.f, 0.f}};
     const Ray ray{{6.f, 1.5f, 0.0005f}, 0.f, {-4.5f, -1.5f, -0.0005f}, kInfinity};
@@ -211,6 +211,16 @@ TEST(Workload, AHitOnATriangleWithoutANormalFacesTheRay) {
     EXPECT_LT(dot(sp.normal, ray.dir), 0.f);
     const Ray shadow = shadow_ray(sp.position, sp.normal, Vec3{0.f, 5.f, 5.f});
     for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::isfinite(shadow.org[a]) && std::isfinite(shadow.dir[a]));
+    // A direction too short to square (a valid ray: one component of at least 2^-126) and normals
+    // whose length under- or overflows: still unit vectors, the latter the plane's own.
+    const Ray tiny{{6.f, 1.5f, 0.0005f}, 0.f, Vec3{-4.5f, -1.5f, -0.0005f} * 1e-30f, kInfinity};
+    EXPECT_NEAR(length(surface_point(line, tiny, hit).normal), 1.f, 1e-6f);
+    const Ray down{{0.f, 0.f, 1.f}, 0.f, {0.f, 0.f, -1.f}, kInfinity};
+    for (const float size : {1e-13f, 1e10f}) {
+        const Triangle flat{Vec3{0.f, 0.f, 0.f}, Vec3{1.f, 0.f, 0.f} * size, Vec3{0.f, 1.f, 0.f} * size};
+        const Vec3 n = surface_point(flat, down, Hit{1.f, 0u, 0.f, 0.f}).normal;
+        EXPECT_EQ(n, Vec3(0.f, 0.f, 1.f)) << size;
+    }
 }
 
 TEST(Workload, RefusesAnUnknownShadingAndAoSamplesOutOfRange) {

@@ -54,10 +54,11 @@ struct PinholeProjection {
 };
 
 // The point a hit names and the triangle's geometric normal there, turned to face the side the ray
-// came from. A triangle whose normal has no direction in float (zero area: the test hits one where
-// rounding gives it an area, as at a T-junction; or a length that under- or overflows) faces the
-// ray: its normal was NaN, and the shadow ray's offset converted NaN to an integer (undefined;
-// found by review, 2026-12-07).
+// came from. Where the normal's length under- or overflows in float (edges of some 5e-12 or 4e9 and
+// beyond) it is normalised from the vector divided by its largest component; a triangle with no
+// normal at all (zero area: the test hits one where rounding gives it an area, as at a T-junction)
+// faces the ray, whose direction is rescaled the same way. Both were NaN or zero, and the shadow
+// ray's offset converted NaN to an integer (undefined; found by review, 2026-12-07).
 struct SurfacePoint {
     Vec3 position, normal;
 };
@@ -65,7 +66,16 @@ struct SurfacePoint {
 CELLRT_HD inline SurfacePoint surface_point(const Triangle& tri, const Ray& ray, const Hit& hit) {
     const Vec3 g = tri.geometric_normal();
     const float len = length(g);
-    Vec3 n = len > 0.f && len < kInfinity ? g * (1.f / len) : -normalize(ray.dir);
+    Vec3 n;
+    if (len > 0.f && len < kInfinity) [[likely]] {
+        n = g * (1.f / len);
+    } else {
+        const auto rescaled = [](const Vec3& a) {
+            return normalize(a * (1.f / std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)))));
+        };
+        const float largest = std::fmax(std::fabs(g.x), std::fmax(std::fabs(g.y), std::fabs(g.z)));
+        n = largest > 0.f && largest < kInfinity ? rescaled(g) : -rescaled(ray.dir);
+    }
     if (dot(n, ray.dir) > 0.f) n = -n;
     return {tri.v0 * (1.f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v, n};
 }
