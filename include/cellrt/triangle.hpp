@@ -101,11 +101,12 @@ CELLRT_HD inline float edge_in_double(float a, float b, float c, float d) {
 // sheared coordinates, at most `lateral` (their largest magnitude) squared or `lateral` times their
 // unsheared size; over det it moves t by as many ulps times the triangle's depth range `depth` over
 // det / `lateral`. Where lateral * depth passes kIllConditioned * |det|, t is taken again in double
-// precision (refined_t). The bound is measured, not proved: over 110,000 hits on slivers of widths
-// from 1e-1 to 1e-7 of their length, half of them on rays grazing their plane, the float t of
-// hits below 64 lay at most 0.05 of the least margin off the triangle, below 256 up to 0.35, and
-// beyond it up to 10^5 times (docs/HIT_SEMANTICS.md). Healthy hits stay far below: a triangle seen
-// at 45 degrees gives about 1, at 5 degrees about 11; of Sponza's camera rays 2.7 % pass 64.
+// precision (refined_t). The bound is measured, not proved: of 109,751 hits on slivers of widths
+// from 1e-1 to 1e-7 of their length, half of them on rays grazing their plane, the float t of the
+// 16,817 below 64 lay at most 0.05 of the least margin off the triangle, of those below 256 up to
+// 0.35, beyond 4096 up to 10^5 times (docs/figures/exact_hits_2026-12-07). Healthy hits stay far
+// below: a triangle seen at 45 degrees gives about 1, at 5 degrees about 11; of Sponza's camera
+// rays' hits 2.7 % pass 64.
 inline constexpr float kIllConditioned = 64.f;
 
 // Whether a hit with these magnitudes needs refined_t. The same operations in the same order on
