@@ -70,11 +70,9 @@ CELLRT_HD inline SurfacePoint surface_point(const Triangle& tri, const Ray& ray,
     if (len > 0.f && len < kInfinity) [[likely]] {
         n = g * (1.f / len);
     } else {
-        const auto rescaled = [](const Vec3& a) {
-            return normalize(a * (1.f / std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)))));
-        };
-        const float largest = std::fmax(std::fabs(g.x), std::fmax(std::fabs(g.y), std::fabs(g.z)));
-        n = largest > 0.f && largest < kInfinity ? rescaled(g) : -rescaled(ray.dir);
+        const auto largest = [](const Vec3& a) { return std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z))); };
+        const float gm = largest(g);
+        n = gm > 0.f && gm < kInfinity ? normalize(g * (1.f / gm)) : -normalize(ray.dir * (1.f / largest(ray.dir)));
     }
     if (dot(n, ray.dir) > 0.f) n = -n;
     return {tri.v0 * (1.f - hit.u - hit.v) + tri.v1 * hit.u + tri.v2 * hit.v, n};
