@@ -38,6 +38,7 @@
 #include "cellrt/accel.hpp"
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
 #include "core/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
@@ -242,18 +243,24 @@ std::string csv_row(const std::string& scene, const Run& run, const Result& r, s
     const double frame_ms = r.kernel_seconds > 0.0
                                 ? 1e3 * r.kernel_seconds / static_cast<double>(s.rays) * static_cast<double>(frame_rays)
                                 : s.cycles_per_ray() * static_cast<double>(frame_rays) / (c.cost.clock_ghz * 1e6);
+    // A cache the sampled rays never read has no hit ratio: an empty field, where 0 read as the worst.
+    auto ratio = [](const CacheStats& c) {
+        char text[32] = "";
+        if (c.hits + c.misses > 0) std::snprintf(text, sizeof text, "%.6f", c.hit_ratio());
+        return std::string(text);
+    };
     char buf[1024];
     std::snprintf(buf, sizeof buf,
-                  "%s,%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%.6f,%llu,%llu,%llu,%llu,%llu,%.6f,%llu,%llu,"
+                  "%s,%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%s,%llu,%llu,"
                   "%llu,%llu,%.3f,%.4f,%.4f\n",
                   scene.c_str(), run.structure.c_str(), run.traversal.c_str(), to_string(c.access), run.sweep.c_str(),
                   c.node_cache.to_string().c_str(), c.node_cache.line_bytes, c.node_cache.sets, c.node_cache.ways,
                   c.triangle_cache.to_string().c_str(), c.triangle_cache.line_bytes, c.triangle_cache.sets,
                   c.triangle_cache.ways, static_cast<unsigned long long>(s.rays),
-                  static_cast<unsigned long long>(n.hits), static_cast<unsigned long long>(n.misses), n.hit_ratio(),
+                  static_cast<unsigned long long>(n.hits), static_cast<unsigned long long>(n.misses), ratio(n).c_str(),
                   static_cast<unsigned long long>(n.prefetches), static_cast<unsigned long long>(n.bytes),
                   static_cast<unsigned long long>(n.evictions), static_cast<unsigned long long>(t.hits),
-                  static_cast<unsigned long long>(t.misses), t.hit_ratio(), static_cast<unsigned long long>(t.bytes),
+                  static_cast<unsigned long long>(t.misses), ratio(t).c_str(), static_cast<unsigned long long>(t.bytes),
                   static_cast<unsigned long long>(t.evictions), static_cast<unsigned long long>(s.cycles),
                   static_cast<unsigned long long>(s.stall_cycles), s.cycles_per_ray(), frame_ms, r.wall_seconds);
     return buf;
@@ -382,6 +389,10 @@ Runner add_cache_study(CLI::App& app) {
                 std::error_code ec;
                 if (std::filesystem::is_directory(o->out, ec))
                     for (const std::string& p : {csv_path, md_path}) check_output_file(p, o->overwrite);
+                std::vector<std::pair<std::string, std::string>> inputs;
+                for (const std::string& spec : o->scenes)
+                    for (auto& file : scene_files(spec)) inputs.push_back(std::move(file));
+                check_distinct_files({{"--out", csv_path}, {"--out", md_path}}, inputs);
             }
         }, "checking the options");
         const unsigned threads = o->threads ? o->threads : cluster::cores();
@@ -392,8 +403,14 @@ Runner add_cache_study(CLI::App& app) {
                          (gpu ? "kernel ns/ray" : "cycles/ray") +
                          " | best direct-mapped | the study's layout | study / best |\n|---|---|---|---|---|---|---|---|---|\n";
         Timer total;
+        std::map<std::string, std::string> named;  // scene name -> the spec that gave it
         for (const std::string& spec : o->scenes) {
             const Scene scene = cluster::load_scene(spec);
+            // The results name their rows by the scene: two scenes of one name would be one in the
+            // CSV, the table and the graphs.
+            if (const auto [at, fresh] = named.emplace(scene.name, spec); !fresh)
+                throw Error(spec + " and " + at->second + " are both the scene '" + scene.name +
+                            "', and the results name their rows by scene: give one view file another \"name\"");
             int width = scene.width, height = scene.height;
             FrameRays w;
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;

@@ -15,6 +15,7 @@
 #include "profile/frame_profile.hpp"
 #include "profile/hardware_counters.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
 #include "core/files.hpp"
 #include "cellrt/scene.hpp"
 #include "cli.hpp"
@@ -273,7 +274,7 @@ int run_profile(const ProfileOptions& o) {
     p.hardware = use_hardware_counters(o.method);
     if (!o.json.empty()) {
         check_output_file(o.json, o.overwrite);
-        check_distinct_files({{"--json", o.json}}, {{"scene", o.scene}});
+        check_distinct_files({{"--json", o.json}}, scene_files(o.scene));
     }
     if (o.packet < 1 || o.packet > kMaxPacket)
         throw Error("--packet " + std::to_string(o.packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");

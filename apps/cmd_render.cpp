@@ -9,6 +9,7 @@
 #include "accel/local_store_registry.hpp"
 #include "cellrt/builtin.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
 #include "core/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
@@ -207,7 +208,7 @@ Runner add_render(CLI::App& app) {
             if (cluster::leader()) {
                 check_output_file(o->out, o->overwrite);
                 if (!o->stats.empty()) check_output_file(o->stats, o->overwrite);
-                check_distinct_files({{"-o", o->out}, {"--stats", o->stats}}, {{"scene", o->scene}});
+                check_distinct_files({{"-o", o->out}, {"--stats", o->stats}}, scene_files(o->scene));
             }
         }, "checking the options");
         Timer load_timer;

@@ -108,7 +108,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     app.add_option("--batch", o.batch, "Rays per accelerator call")->capture_default_str()->check(CLI::Range(1, 1 << 20));
     app.add_option("--threads", o.threads, "Build threads (tracing is single-threaded)")->capture_default_str();
     app.add_option("--size", o.size, "Image size WxH (default: the view file's)");
-    app.add_option("--json", o.json_path, "Write every result as JSON");
+    app.add_option("--json", o.json_path, "Write every result as JSON")->check(bench::non_empty_path());
     app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
     app.add_option("--rays", o.ray_kind,
                    "frame: a frame's primary and shadow rays; ao: its primary and AO rays; diffuse: its primary "
@@ -406,7 +406,9 @@ nlohmann::json bench_scene(const Scene& scene, const Options& o) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-    bench::check_results_paths({{"--json", o.json_path}}, o.overwrite);
+    std::vector<std::string> named;
+    for (const std::string& name : o.scenes) named.push_back(bench::scene_file(o.scenes_dir, name));
+    bench::check_results_paths({{"--json", o.json_path}}, o.overwrite, named);
     const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes, o.scenes_named);
     nlohmann::json out = nlohmann::json::array();
     // A scene a run: its configurations, Embree's among them, stay together on one process.

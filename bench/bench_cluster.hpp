@@ -15,6 +15,7 @@
 
 #include "bench_common.hpp"
 #include "cellrt/error.hpp"
+#include "cellrt/loaders.hpp"
 #include "cluster.hpp"
 #include "core/files.hpp"
 
@@ -56,13 +57,19 @@ inline std::vector<std::string> found_scenes(const std::string& scenes_dir, cons
 
 // Refuses, before any run, results files (option, path; "" not asked for) that cannot be written, on
 // the leader, which writes them: a folder not there, a file the user has without `overwrite`, two
-// options naming one file. A mistyped path should not cost the sweep, nor a sweep a file.
-inline void check_results_paths(const std::vector<std::pair<std::string, std::string>>& outputs, bool overwrite) {
+// options naming one file, one naming a file of the scenes `specs` read (scene_files: a view file or
+// its mesh, which --overwrite would have replaced). A mistyped path should not cost the sweep, nor a
+// sweep a file.
+inline void check_results_paths(const std::vector<std::pair<std::string, std::string>>& outputs, bool overwrite,
+                                const std::vector<std::string>& specs) {
     cluster::together([&] {
         if (!cluster::leader()) return;
         for (const auto& [option, path] : outputs)
             if (!path.empty()) check_output_file(path, overwrite);
-        check_distinct_files(outputs);
+        std::vector<std::pair<std::string, std::string>> inputs;
+        for (const std::string& spec : specs)
+            for (auto& file : scene_files(spec)) inputs.push_back(std::move(file));
+        check_distinct_files(outputs, inputs);
     }, "checking the results' paths");
 }
 

@@ -13,11 +13,20 @@
 #include <malloc.h>
 #endif
 
+#include <CLI/CLI.hpp>
+
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
 #include "kernel/named.hpp"
 
 namespace cellrt::bench {
+
+// The check of a results file's option: an empty name is refused as the programs' other paths are
+// ("--json: must not be empty"), where it used to run the sweep and write nothing.
+inline CLI::Validator non_empty_path() {
+    return CLI::Validator([](const std::string& s) { return s.empty() ? std::string("must not be empty") : std::string(); },
+                          "PATH");
+}
 
 // The median of repeated timings: robust to the odd slow run on a shared machine.
 inline double median(std::vector<double> v) {

@@ -20,6 +20,7 @@
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
+#include "cellrt/loaders.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
 #include "core/files.hpp"
@@ -248,13 +249,19 @@ int main(int argc, char** argv) {
     app.add_option("--ao-samples", o.ao_samples, "AO rays per hit")->capture_default_str()->check(CLI::Range(1, kMaxAoSamples));
     app.add_option("--repeats", o.repeats, "Timed passes (median)")->capture_default_str()->check(CLI::Range(1, 1000));
     app.add_option("--threads", o.threads, "Host threads for the yardstick (0: all)")->capture_default_str();
-    app.add_option("--json", o.json_path, "Write every result as JSON");
+    app.add_option("--json", o.json_path, "Write every result as JSON")->check(bench::non_empty_path());
     app.add_flag("--overwrite", o.overwrite, "Replace an existing --json file");
     cli::cluster::start(argc, argv, "cellrt_gpu_bench");
     cli::cluster::strict_numbers(app);
     if (const int status = cli::cluster::parse(app, argc, argv); status >= 0) return status;
     try {
-        if (!o.json_path.empty()) check_output_file(o.json_path, o.overwrite);
+        if (!o.json_path.empty()) {
+            check_output_file(o.json_path, o.overwrite);
+            std::vector<std::pair<std::string, std::string>> inputs;
+            for (const std::string& name : o.scenes)
+                for (auto& file : scene_files(bench::scene_file(o.scenes_dir, name))) inputs.push_back(std::move(file));
+            check_distinct_files({{"--json", o.json_path}}, inputs);
+        }
     } catch (const Error& e) {
         cli::cluster::print_error(e);
         return 1;

@@ -65,13 +65,33 @@ def save(fig, outdir, graph, scene, what):
     print(path)
 
 
+def hit_ratio(row, cache):
+    """The row's hit ratio in per cent; NaN (a gap in the curve) where the cache had no reads."""
+    value = row[cache + "_hit_ratio"]
+    return 100.0 * float(value) if value else float("nan")
+
+
+COLUMNS = {"scene", "structure", "traversal", "access", "sweep", "node_line", "node_sets", "node_ways", "tri_line",
+           "tri_sets", "tri_ways", "node_hit_ratio", "tri_hit_ratio", "cycles", "frame_ms"}
+
+
 def main() -> int:
     if len(sys.argv) != 3:
         print(__doc__, file=sys.stderr)
         return 2
-    with open(sys.argv[1], encoding="utf-8", newline="") as f:
-        rows = list(csv.DictReader(f))
-    os.makedirs(sys.argv[2], exist_ok=True)
+    try:
+        with open(sys.argv[1], encoding="utf-8", newline="") as f:
+            reader = csv.DictReader(f)
+            missing = COLUMNS - set(reader.fieldnames or [])
+            if missing:
+                raise ValueError(f"{sys.argv[1]}: not a cache-study CSV (no column {', '.join(sorted(missing))})")
+            rows = list(reader)
+        if not rows:
+            raise ValueError(f"{sys.argv[1]}: no results, only the header")
+        os.makedirs(sys.argv[2], exist_ok=True)
+    except (OSError, ValueError) as e:
+        print(f"plot_cache_study.py: error: {e}", file=sys.stderr)
+        return 1
     outdir = sys.argv[2]
     groups = defaultdict(list)  # (scene, structure, sweep) -> rows
     for r in rows:
@@ -88,7 +108,7 @@ def main() -> int:
         fig, axes = plt.subplots(1, len(accesses), figsize=(5.5 * len(accesses), 4.2), squeeze=False)
         for ax, access in zip(axes[0], accesses):
             sel = [r for r in rs if r["access"] == access and r["traversal"] == hit_traversal]
-            draw(ax, curves(sel, sweep, lambda r: 100.0 * float(r[cache + "_hit_ratio"])), "hit ratio (%)",
+            draw(ax, curves(sel, sweep, lambda r: hit_ratio(r, cache)), "hit ratio (%)",
                  f"{scene}, {structure}: {name}, {access}")
         axes[0][-1].legend(fontsize=7)
         save(fig, outdir, hit_graph, scene, f"{structure}_{sweep}_hit_ratio")

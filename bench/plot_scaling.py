@@ -5,8 +5,10 @@ efficiency against workers, one row per dispatch mode; colour = structure, line 
 usage: bench/plot_scaling.py scaling.json [more.json ...] OUTDIR   (Debian's python3, python3-matplotlib)
 
 Several runs are drawn together; a point that more than one of them measured is taken from the first.
-The efficiency is the JSON's own (the median of each round's ratio to the fewest workers) where it has
-one, else t(first) first / (t(N) N) from the medians.
+Runs of one scene must have measured the same frames (the shading, its AO samples and, within 1 %,
+the frame's rays, which the frame size sets): otherwise the script names the two files and draws nothing, as one
+curve would join points of different work. The efficiency is the JSON's own (the median of each
+round's ratio to the fewest workers) where it has one, else t(first) first / (t(N) N) from the medians.
 """
 import json
 import os
@@ -27,24 +29,40 @@ def main() -> int:
         return 2
     *inputs, outdir = sys.argv[1:]
     seen = set()
+    frames = {}  # scene -> (what its frames were, the file that said so)
     # scene -> dispatch -> (config, packet) -> [(workers, seconds, efficiency or None)]
     data = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))
-    for path in inputs:
-        with open(path, encoding="utf-8") as f:
-            for p in json.load(f):
+    try:
+        for path in inputs:
+            with open(path, encoding="utf-8") as f:
+                points = json.load(f)
+            for p in points:
+                frame = (p.get("shading", "direct"), p.get("ao_samples"), p["rays"])
+                first, other = frames.setdefault(p["scene"], (frame, path))
+                # The rays within 1 %: the structures' shadow rays may differ by a hit or two (Embree's
+                # test is not cellrt's), another frame size by far more.
+                if first[:2] != frame[:2] or abs(first[2] - frame[2]) > 0.01 * first[2]:
+                    raise ValueError(f"{path} and {other} traced other frames of {p['scene']} (shading, AO samples "
+                                     f"and rays: {frame} against {first}): draw them apart")
                 key = (p["scene"], p["dispatch"], p["config"], p["packet"], p["workers"])
                 if key in seen:
                     continue
                 seen.add(key)
                 data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append(
                     (p["workers"], p["seconds"], p.get("efficiency")))
-    os.makedirs(outdir, exist_ok=True)
+        os.makedirs(outdir, exist_ok=True)
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        print(f"plot_scaling.py: error: {e if not isinstance(e, KeyError) else f'a point has no {e}'}",
+              file=sys.stderr)
+        return 1
     for scene, by_dispatch in data.items():
         dispatches = sorted(by_dispatch)
         configs = sorted({c for d in by_dispatch.values() for c, _ in d})
         packets = sorted({p for d in by_dispatch.values() for _, p in d})
         colour = {c: f"C{i}" for i, c in enumerate(configs)}
         style = {p: STYLES[i % len(STYLES)] for i, p in enumerate(packets)}
+        shading = frames[scene][0][0]
+        highest = 0.0  # the efficiency axis reaches the highest point (a noisy short run passes 1)
         fig, axes = plt.subplots(len(dispatches), 2, figsize=(11, 3.6 * len(dispatches)), squeeze=False)
         for row, d in enumerate(dispatches):
             ax_t, ax_e = axes[row]
@@ -55,12 +73,16 @@ def main() -> int:
                 label = f"{config} {packet}x{packet}"
                 kw = dict(color=colour[config], linestyle=style[packet], marker="o", label=label)
                 ax_t.plot(w, t, **kw)
-                ax_e.plot(w, [e if e is not None else t[0] * w[0] / (ti * wi) for wi, ti, e in pts], **kw)
-            ax_t.set(xlabel="workers", ylabel="seconds per frame", title=f"{scene}, {d}: time", yscale="log")
-            ax_e.set(xlabel="workers", ylabel="parallel efficiency", title=f"{scene}, {d}: efficiency",
-                     ylim=(0, 1.15))
+                eff = [e if e is not None else t[0] * w[0] / (ti * wi) for wi, ti, e in pts]
+                highest = max([highest] + eff)
+                ax_e.plot(w, eff, **kw)
+            ax_t.set(xlabel="workers", ylabel="seconds per frame", title=f"{scene} ({shading}), {d}: time",
+                     yscale="log")
+            ax_e.set(xlabel="workers", ylabel="parallel efficiency", title=f"{scene} ({shading}), {d}: efficiency")
             for ax in (ax_t, ax_e):
                 ax.set_xticks(sorted({x for pts in by_dispatch[d].values() for x, _, _ in pts}))
+        for ax in axes[:, 1]:
+            ax.set_ylim(0, max(1.15, 1.05 * highest))
         legend = {}  # every curve of every row, once
         for ax in axes.flat:
             for handle, label in zip(*ax.get_legend_handles_labels()):

@@ -128,8 +128,8 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
         ->capture_default_str()
         ->check(CLI::Range(0, 1000000));
     app.add_flag("--pin", o.pin, "Pin worker i to core i (mailbox: the master to core 0, worker i to core i + 1)");
-    app.add_option("--csv", o.csv_path, "Write every point as CSV");
-    app.add_option("--json", o.json_path, "Write every point as JSON");
+    app.add_option("--csv", o.csv_path, "Write every point as CSV")->check(bench::non_empty_path());
+    app.add_option("--json", o.json_path, "Write every point as JSON")->check(bench::non_empty_path());
     app.add_flag("--overwrite", o.overwrite, "Replace existing --csv and --json files");
     cluster::add_bench_options(app);
     cluster::strict_numbers(app);
@@ -402,7 +402,9 @@ std::string csv_of(const nlohmann::json& rows) {
 int run(int argc, char** argv) {
     Options o;
     if (const std::optional<int> status = parse_options(argc, argv, o)) return *status;
-    bench::check_results_paths({{"--json", o.json_path}, {"--csv", o.csv_path}}, o.overwrite);
+    std::vector<std::string> named;
+    for (const std::string& name : o.scenes) named.push_back(bench::scene_file(o.scenes_dir, name));
+    bench::check_results_paths({{"--json", o.json_path}, {"--csv", o.csv_path}}, o.overwrite, named);
     const std::string yardstick = yardstick_of(o.configs);
     const Study study = measure(o);
     // One table per configuration, dispatch and packet size; then where the time of the most workers went.

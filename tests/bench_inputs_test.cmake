@@ -53,6 +53,29 @@ expect("--csv ${WORK}/link.csv names the same file as --json ${WORK}/x.json"
        ${SCALING} ${small} --configs kd --workers 1 --json ${WORK}/x.json --csv ${WORK}/link.csv)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${SCALING} ${small} --configs kd --workers 1 --csv ${WORK}/mine.json)
+# An output naming a file of a scene the run reads (found by audit, 2026-12-07: cellrt_scaling --csv
+# replaced a view file with --overwrite), and an empty results path, which ran the sweep and wrote
+# nothing.
+file(WRITE ${WORK}/tiny/tiny.obj "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
+file(WRITE ${WORK}/tiny/tiny.json "{\"mesh\": \"tiny.obj\", \"camera\": {\"position\": [0.5, 0.5, 3], \"look_at\": [0.5, 0.5, 0], \"up\": [0, 1, 0], \"fov_y_deg\": 45}, \"light\": {\"position\": [0, 5, 5]}}\n")
+expect("--csv ${WORK}/tiny/tiny.obj names the mesh ${WORK}/tiny/tiny.obj, which it would replace"
+       ${SCALING} --scenes-dir ${WORK} --scenes tiny --size 8x8 --repeats 1 --configs kd --workers 1
+       --csv ${WORK}/tiny/tiny.obj --overwrite)
+expect("--json ${WORK}/tiny/tiny.json names the scene ${WORK}/tiny/tiny.json, which it would replace"
+       ${BENCH} --scenes-dir ${WORK} --scenes tiny --size 8x8 --repeats 1 --configs kd --json ${WORK}/tiny/tiny.json
+       --overwrite)
+foreach(option --json --csv)
+  execute_process(COMMAND ${SCALING} ${small} --configs kd --workers 1 ${option} ""
+                  OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 1 OR NOT err STREQUAL "cellrt_scaling: error: ${option}: must not be empty (see --help)\n")
+    message(FATAL_ERROR "cellrt_scaling ${option} '': status ${rc}, printed '${err}'")
+  endif()
+endforeach()
+file(READ ${WORK}/tiny/tiny.obj mesh)
+if(NOT mesh MATCHES "^v 0 0 0")
+  message(FATAL_ERROR "a refused run replaced the scene's mesh: '${mesh}'")
+endif()
+
 # cellrt_capi_bench: one line and status 1 (a bad scene ended in std::terminate; 2026-12-07).
 execute_process(COMMAND ${CAPI} ${WORK}/missing.obj OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
 if(NOT rc EQUAL 1 OR NOT err MATCHES "^cellrt_capi_bench: error: ${WORK}/missing.obj: no such file\n")

@@ -232,6 +232,15 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     const std::string folder_obj = (dir.path / "folder.obj").string();
     fs::create_directory(folder_obj);
     const std::string good_view = view("good.json", "45"), study = (dir.path / "new_study").string();
+    const std::string tri = (dir.path / "tri.obj").string(), linked = (dir.path / "linked").string();
+    fs::create_directory(linked);
+    fs::create_symlink(good_view, fs::path(linked) / "cache_study.csv");
+    const std::string twin = (dir.path / "twin.json").string();
+    {
+        std::ifstream in(good_view);
+        const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        std::ofstream(twin) << "{\"name\": \"good\", " << text.substr(1);
+    }
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
         {{"info", over}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
         {{"render", over, "-o", out}, over + ":3: invalid JSON: number overflow parsing '1e309'"},
@@ -291,6 +300,16 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         // And profile --json did replace it (found by audit, 2026-12-07).
         {{"profile", good_view, "--json", good_view, "--overwrite"},
          "--json " + good_view + " names the scene " + good_view + ", which it would replace"},
+        // Nor the mesh a view file names, nor, through a link in the output folder, the view file
+        // (found by audit, 2026-12-07); two view files of one name would be one in the results.
+        {{"render", good_view, "-o", out, "--stats", tri, "--overwrite"},
+         "--stats " + tri + " names the mesh " + tri + ", which it would replace"},
+        {{"cache-study", good_view, "--out", linked, "--overwrite"},
+         "--out " + linked + "/cache_study.csv names the scene " + good_view + ", which it would replace"},
+        {{"cache-study", good_view, twin, "--out", study, "--structures", "kd", "--traversals", "branchless", "--access",
+          "sync", "--sweeps", "node"},
+         twin + " and " + good_view + " are both the scene 'good', and the results name their rows by scene: give one "
+                                      "view file another \"name\""},
         {{"cache-study", (dir.path / "missing.obj").string(), "--out", study},
          (dir.path / "missing.obj").string() + ": no such file"},
         // Integers in decimal digits only: CLI11 read `010` as 8, `0x2` as 2, " 4" as 4 and "" as 0
@@ -323,6 +342,10 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     std::ifstream kept(good_view);
     const std::string view_text{std::istreambuf_iterator<char>(kept), std::istreambuf_iterator<char>()};
     EXPECT_NE(view_text.find("\"mesh\""), std::string::npos) << "the view file was replaced";
+    std::ifstream mesh(tri);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(mesh), std::istreambuf_iterator<char>()),
+              "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
+        << "the mesh was replaced";
 }
 
 // An exception thrown on a render worker (here Embree refusing rays beyond its range, from a camera

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cellrt/scene.hpp"
@@ -51,5 +52,11 @@ std::vector<Triangle> load_mesh(const std::string& path);
 // View file (JSON, format of shared/scenes/README.md): the mesh path relative to the file, camera,
 // point light and image size.
 Scene load_view_file(const std::string& path);
+
+// The files loading the scene `spec` (load_scene's argument) reads, as (what, path), so that a
+// program can refuse an output that would replace one of them before any work: ("scene", spec) and,
+// for a view file, ("mesh", the mesh it names); none for a built-in scene. A view file that cannot
+// be read as one gives itself alone (loading it names what is wrong).
+std::vector<std::pair<std::string, std::string>> scene_files(const std::string& spec);
 
 }  // namespace cellrt

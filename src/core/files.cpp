@@ -166,12 +166,23 @@ void check_output_folder(const std::string& option, const std::string& path) {
     fs::path at = fs::absolute(path, ec);
     if (ec) throw Error(named + ": " + ec.message());
     // The nearest part of the path that exists must be a folder this process may write in.
-    while (!fs::exists(at, ec) && at.has_parent_path() && at.parent_path() != at) at = at.parent_path();
+    fs::path missing;  // the first part below it that does not exist, if any
+    while (!fs::exists(at, ec) && at.has_parent_path() && at.parent_path() != at) {
+        missing = at;
+        at = at.parent_path();
+    }
     if (!fs::is_directory(at, ec))
         throw Error(named + ": " + at.string() + " is a file, not a folder");
     if (::access(at.c_str(), W_OK | X_OK) != 0) {
         const int error = errno;
         throw Error(named + ": cannot write in " + at.string() + " (" + std::strerror(error) + ")");
+    }
+    // Where the system says yes but making a folder there fails (/proc for root), the folder is made
+    // once and taken away again: a run should not find that out after its work.
+    if (!missing.empty()) {
+        if (::mkdir(missing.c_str(), 0700) == 0) ::rmdir(missing.c_str());
+        else if (const int error = errno; error != EEXIST)
+            throw Error(named + ": cannot make a folder in " + at.string() + " (" + std::strerror(error) + ")");
     }
 }
 

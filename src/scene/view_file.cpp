@@ -10,6 +10,7 @@
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/loaders.hpp"
+#include "core/files.hpp"
 #include "core/read_file.hpp"
 
 namespace cellrt {
@@ -193,5 +194,19 @@ private:
 }  // namespace
 
 Scene load_view_file(const std::string& path) { return ViewReader(path).read(); }
+
+std::vector<std::pair<std::string, std::string>> scene_files(const std::string& spec) {
+    if (spec.empty() || spec.rfind("builtin:", 0) == 0) return {};
+    std::vector<std::pair<std::string, std::string>> files{{"scene", spec}};
+    if (lower_extension(spec) != ".json") return files;
+    try {
+        const json doc = json::parse(detail::read_file(spec), nullptr, true, /*ignore_comments=*/true);
+        if (doc.is_object() && doc.contains("mesh") && doc["mesh"].is_string())
+            files.emplace_back("mesh", (std::filesystem::path(spec).parent_path() / doc["mesh"].get<std::string>()).string());
+    } catch (const std::exception&) {
+        // Not a view file one can read: loading it says why.
+    }
+    return files;
+}
 
 }  // namespace cellrt
