@@ -103,6 +103,22 @@ CLI::Validator non_empty() {
 
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
                                              const AccelOptions& options) {
+    // A tree's single-ray kernel named with SIMD packets, which would replace it (the library refuses
+    // it too): said in the options' words, once the SIMD set is known to be one.
+    if (names_replaced_traversal(config)) {
+        try {
+            detail::parse_isa(config.simd);
+        } catch (const Error& e) {
+            throw Error(options.simd_source() + ": " + e.what());
+        }
+        const std::string kernel =
+            options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'";
+        if (kernel == options.simd_source())
+            throw Error(kernel + " names a single-ray kernel ('" + config.traversal + "') and SIMD packets ('" +
+                        config.simd + "'), which would replace it: leave one of them out");
+        throw Error(kernel + " names a single-ray kernel, which the SIMD packets of " + options.simd_source() +
+                    " replace: leave one of them out");
+    }
     std::unique_ptr<Accelerator> accel;
     try {
         accel = make_accelerator(triangles, config);
@@ -114,17 +130,6 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
             throw Error(options.simd_source() + ": " + e.what());
         }
         throw;
-    }
-    // A structure whose traversals are single-ray kernels runs its SIMD packets instead: asked for
-    // together, the traversal would be dropped without a word (the BVH's take an instruction set).
-    if (!config.traversal.empty() && accel->stats().traversal != config.traversal) {
-        const std::string kernel =
-            options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'";
-        if (kernel == options.simd_source())
-            throw Error(kernel + " names a single-ray kernel ('" + config.traversal + "') and SIMD packets ('" +
-                        config.simd + "'), which would replace it: leave one of them out");
-        throw Error(kernel + " names a single-ray kernel, which the SIMD packets of " + options.simd_source() +
-                    " replace: leave one of them out");
     }
     return accel;
 }

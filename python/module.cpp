@@ -140,7 +140,10 @@ AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, p
                                   "and parameters as params=");
         c = parse_accel_config(spec);
     }
-    c.simd = text(simd, "simd");
+    // None: the best packets, or one ray at a time where kind names a tree's single-ray kernel, which
+    // packets would replace (names_replaced_traversal; a SIMD set given with one is refused).
+    c.simd = simd.is_none() ? "auto" : text(simd, "simd");
+    if (simd.is_none() && names_replaced_traversal(c)) c.simd = "off";
     c.device = place;
     if (c.device == "cuda" && c.simd == "auto") c.simd = "off";
     c.threads = small_count(threads, "threads", kMaxWorkers);
@@ -376,10 +379,11 @@ PYBIND11_MODULE(cellrt, m) {
                  return build(faces.is_none() ? triangle_soup(first) : indexed_triangles(first, faces), config);
              }),
              py::arg("vertices"), py::arg("faces") = py::none(), py::kw_only(), py::arg("kind") = py::none(),
-             py::arg("simd") = "auto", py::arg("threads") = 0, py::arg("params") = py::dict(),
+             py::arg("simd") = py::none(), py::arg("threads") = 0, py::arg("params") = py::dict(),
              py::arg("device") = "cpu",
-             "Accelerator(vertices (N,3), faces (M,3), kind=None, simd='auto', threads=0, params={}, device='cpu'), "
-             "or Accelerator(triangles (M,3,3), ...). kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); None: 'auto' "
+             "Accelerator(vertices (N,3), faces (M,3), kind=None, simd=None, threads=0, params={}, device='cpu'), "
+             "or Accelerator(triangles (M,3,3), ...). simd None: 'auto', or 'off' where kind names the kd-tree's or "
+             "the BIH's single-ray kernel. kind: KIND or KIND:TRAVERSAL (cellrt.kinds()); None: 'auto' "
              "with params packets='bvh' on the CPU, 'kd' on the GPU; device: 'cpu' or 'cuda' (cellrt.device_info()); "
              "the GIL is released during the build.")
         .def("intersect", &py_intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0,

@@ -14,8 +14,9 @@
 namespace cellrt {
 
 // Builds the structure `config.kind` over `triangles`. Throws cellrt::Error for an unknown kind,
-// traversal or parameter, a parameter out of range, or a triangle with a NaN or infinite coordinate
-// (naming the first). An empty span is a scene every ray misses.
+// traversal or parameter, a parameter out of range, a triangle with a NaN or infinite coordinate
+// (naming the first), and a tree's single-ray kernel named with SIMD packets, which replace it
+// (names_replaced_traversal). An empty span is a scene every ray misses.
 //
 // What the accelerator keeps: brute force and the kd-tree read `triangles` itself (the kd-tree's
 // leaves index it) on every call, so it must outlive the accelerator, unchanged; the BIH keeps a
@@ -30,6 +31,12 @@ std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangle
 // SIMD packets (simd other than "off"), a build without CUDA, or no device (naming CUDA's reason).
 // It keeps nothing of `triangles`: the tree and its triangles are copied to the device.
 std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
+
+// Whether `config` names one of a tree's single-ray kernels (the kd-tree's or the BIH's traversals)
+// together with SIMD packets (simd other than "off"), which trace the batches in its stead: the
+// kernel would be dropped without a word, so make_accelerator refuses it ("kd:rec+auto"). The wide
+// BVH's traversals take an instruction set and are not such kernels.
+bool names_replaced_traversal(const AccelConfig& config);
 
 // An accelerator configuration written as one string, as the benchmarks and tests name them:
 // KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...], e.g. "kd:rec", "bih+avx2", "kd+auto@leaf_size=2,bins=64".

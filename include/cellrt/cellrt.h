@@ -17,8 +17,8 @@
  * Thread safety. Every function may be called from any number of threads at once. intersect and
  * occluded calls may run at once on one accelerator and each gets the answers it gets alone; they must
  * not write overlapping result arrays. A handle released while another thread's call is using it stays
- * alive until that call returns. Error records are per thread; the error function may be called from
- * several threads at once and must be safe for that.
+ * alive until that call returns. Error records are per thread, and end with their thread; the error
+ * function may be called from several threads at once and must be safe for that.
  *
  * Lifetimes. Input arrays are read only during the call that takes them (a scene copies its vertices
  * and indices). Results are written only by the call, before it returns. */
@@ -102,7 +102,9 @@ CELLRT_API cellrt_error cellrt_device_set_error_function(cellrt_device device, c
                                                         void* user);
 /* The calling thread's latest error on `device` (NULL: errors that had no device), then reset to
  * CELLRT_SUCCESS. When `message` is not NULL it receives that error's message ("" for none), valid
- * until the calling thread's next error on the device. */
+ * until the calling thread's next error on the device, until the device is released (its records
+ * are then dropped as the thread records other errors) or until the thread ends, whichever comes
+ * first: copy it to keep it. */
 CELLRT_API cellrt_error cellrt_device_get_error(cellrt_device device, const char** message);
 
 /* Scenes: triangles from float32 xyz vertices (3 * vertex_count floats) and uint32 indices

@@ -95,7 +95,20 @@ std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangle
     if (config.device != "cpu") throw Error("device '" + config.device + "' is not one of: cpu, cuda");
     const Entry& e = entry(config.kind);
     check_finite(triangles);
+    // Found by audit (2026-12-07): the C API and Python built "kd:rec+auto" and reported it as such,
+    // while its packets traced every batch.
+    if (names_replaced_traversal(config))
+        throw Error("'" + format_accel_config(config) + "' names a single-ray kernel ('" + config.traversal +
+                    "') and SIMD packets ('" + config.simd + "'), which would replace it: leave one of them out");
     return e.make(triangles, config);
+}
+
+bool names_replaced_traversal(const AccelConfig& config) {
+    if (config.simd == "off" || config.traversal.empty()) return false;
+    const auto& trees = entries();
+    const auto e = std::find_if(trees.begin(), trees.end(), [&](const Entry& t) { return t.kind == config.kind; });
+    return e != trees.end() && e->local_store &&
+           std::find(e->traversals.begin(), e->traversals.end(), config.traversal) != e->traversals.end();
 }
 
 std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Triangle> triangles,

@@ -233,9 +233,20 @@ auto soa_loader(const cellrt_rays_soa& s) {
     };
 }
 
+// An array of `count` elements of `element` bytes: not NULL unless empty, and no larger than an
+// object can be (a count whose bytes overflowed size_t read and wrote past the caller's arrays; found
+// by audit, 2026-12-07).
+void check_array(const void* p, const char* name, std::size_t count, std::size_t element) {
+    if (count > 0 && !p) fail(CELLRT_ERROR_INVALID_ARGUMENT, std::string(name) + " is NULL, count " + str(count));
+    if (count > static_cast<std::size_t>(PTRDIFF_MAX) / element)
+        fail(CELLRT_ERROR_INVALID_ARGUMENT, "count " + str(count) + " is too large: " + name + " would take more than " +
+                                                str(static_cast<std::size_t>(PTRDIFF_MAX)) + " bytes");
+}
+
 void check_soa(const cellrt_rays_soa* rays, std::size_t count) {
     if (count == 0) return;
     if (!rays) fail(CELLRT_ERROR_INVALID_ARGUMENT, "rays is NULL, count " + str(count));
+    check_array(rays, "each of rays' arrays", count, sizeof(float));
     const struct {
         const float* p;
         const char* name;
@@ -245,9 +256,6 @@ void check_soa(const cellrt_rays_soa* rays, std::size_t count) {
         if (!r.p) fail(CELLRT_ERROR_INVALID_ARGUMENT, std::string("rays->") + r.name + " is NULL, count " + str(count));
 }
 
-void check_array(const void* p, const char* name, std::size_t count) {
-    if (count > 0 && !p) fail(CELLRT_ERROR_INVALID_ARGUMENT, std::string(name) + " is NULL, count " + str(count));
-}
 
 }  // namespace
 }  // namespace cellrt::capi
@@ -422,8 +430,8 @@ cellrt_error cellrt_intersect(cellrt_accel accel, const cellrt_ray* rays, cellrt
     return guarded("cellrt_intersect", d, [&] {
         const auto a = find<Accel>(id_of(accel), "accel");
         d = a->device;
-        check_array(rays, "rays", count);
-        check_array(hits, "hits", count);
+        check_array(rays, "rays", count, sizeof(cellrt_ray));
+        check_array(hits, "hits", count, sizeof(cellrt_hit));
         intersect_all(*a->accelerator, count, [&](std::size_t i) { return ray_of(rays[i]); },
                       [&](std::size_t i, const cellrt::Hit& h) { hits[i] = {h.t, h.prim, h.u, h.v}; });
     });
@@ -437,9 +445,9 @@ cellrt_error cellrt_intersect_soa(cellrt_accel accel, const cellrt_rays_soa* ray
         d = a->device;
         check_soa(rays, count);
         if (count == 0) return;
-        check_array(hits, "hits", count);
-        check_array(hits->t, "hits->t", count);
-        check_array(hits->prim, "hits->prim", count);
+        check_array(hits, "hits", count, sizeof(float));
+        check_array(hits->t, "hits->t", count, sizeof(float));
+        check_array(hits->prim, "hits->prim", count, sizeof(uint32_t));
         const cellrt_hits_soa out = *hits;
         intersect_all(*a->accelerator, count, soa_loader(*rays), [&](std::size_t i, const cellrt::Hit& h) {
             out.t[i] = h.t;
@@ -455,8 +463,8 @@ cellrt_error cellrt_occluded(cellrt_accel accel, const cellrt_ray* rays, uint8_t
     return guarded("cellrt_occluded", d, [&] {
         const auto a = find<Accel>(id_of(accel), "accel");
         d = a->device;
-        check_array(rays, "rays", count);
-        check_array(occluded, "occluded", count);
+        check_array(rays, "rays", count, sizeof(cellrt_ray));
+        check_array(occluded, "occluded", count, sizeof(uint8_t));
         occluded_all(*a->accelerator, count, [&](std::size_t i) { return ray_of(rays[i]); }, occluded);
     });
 }
@@ -467,7 +475,7 @@ cellrt_error cellrt_occluded_soa(cellrt_accel accel, const cellrt_rays_soa* rays
         const auto a = find<Accel>(id_of(accel), "accel");
         d = a->device;
         check_soa(rays, count);
-        check_array(occluded, "occluded", count);
+        check_array(occluded, "occluded", count, sizeof(uint8_t));
         if (count == 0) return;
         occluded_all(*a->accelerator, count, soa_loader(*rays), occluded);
     });

@@ -357,6 +357,15 @@ static int part_errors(void) {
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "nosuch");
     CHECK(cellrt_accel_new(scene, "kd@leaf_size=-5") == NULL);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "leaf_size");
+    /* A tree's single-ray kernel with SIMD packets, which would replace it (built and reported as
+     * asked until found by audit, 2026-12-07); the BVH's traversals take a SIMD set. */
+    CHECK(cellrt_accel_new(scene, "kd:rec+auto") == NULL);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG,
+                "'kd:rec+auto' names a single-ray kernel ('rec') and SIMD packets ('auto'), which would replace it");
+    CHECK(cellrt_accel_new(scene, "bih:branchless+avx2") == NULL);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "names a single-ray kernel ('branchless')");
+    accel = cellrt_accel_new(scene, "bvh:paired+auto");
+    CHECK(accel != NULL && cellrt_accel_release(accel) == CELLRT_SUCCESS);
     fallback = cellrt_accel_new(scene, NULL); /* NULL: the CPU's default, auto@packets=bvh */
     CHECK(fallback != NULL);
     /* What an accelerator is: NULL's configuration named in full, a given one in canonical form. */
@@ -416,6 +425,21 @@ static int part_errors(void) {
     CHECK(cellrt_intersect(fallback, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "hits is NULL");
     CHECK(cellrt_intersect(fallback, NULL, NULL, 0) == CELLRT_SUCCESS);
+    /* Counts whose arrays cannot exist: refused before any ray is read (a crash until 2026-12-07). */
+    CHECK(cellrt_intersect(fallback, &ray, &hit, SIZE_MAX / 16) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "is too large: rays would take more than");
+    CHECK(cellrt_occluded(fallback, &ray, &occ, SIZE_MAX / 16) == CELLRT_ERROR_INVALID_ARGUMENT);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "is too large: rays would take more than");
+    {
+        float x = 0.f;
+        const cellrt_rays_soa soa = {&x, &x, &x, &x, &x, &x, NULL, NULL};
+        uint32_t prim = 0;
+        const cellrt_hits_soa out = {&x, &prim, NULL, NULL};
+        CHECK(cellrt_intersect_soa(fallback, &soa, &out, SIZE_MAX / 2) == CELLRT_ERROR_INVALID_ARGUMENT);
+        CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "is too large");
+        CHECK(cellrt_occluded_soa(fallback, &soa, &occ, SIZE_MAX / 2) == CELLRT_ERROR_INVALID_ARGUMENT);
+        CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "is too large");
+    }
     CHECK(cellrt_occluded(fallback, NULL, &occ, 1) == CELLRT_ERROR_INVALID_ARGUMENT);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_ARGUMENT, "cellrt_occluded: rays is NULL");
     CHECK(cellrt_occluded(fallback, &ray, NULL, 1) == CELLRT_ERROR_INVALID_ARGUMENT);

@@ -65,6 +65,20 @@ def test_single_ray_traversals(case):
         assert_same_hits(cellrt.Accelerator(scene.triangles, kind=kind, simd="off").intersect(*rays), hits)
 
 
+def test_a_tree_kernel_runs_alone_and_is_refused_with_packets(case):
+    # simd=None takes one ray at a time for a kd-tree or BIH kernel; named with a SIMD set, whose
+    # packets would replace it, it is refused (it ran the packets and reported the kernel until an
+    # audit, 2026-12-07).
+    scene, rays, hits, _ = case
+    for kind in ("kd:rec", "bih:branchless"):
+        acc = cellrt.Accelerator(scene.triangles, kind=kind)
+        assert acc.config == kind and acc.stats.traversal == kind.split(":")[1]
+        assert_same_hits(acc.intersect(*rays), hits)
+        with pytest.raises(ValueError, match="names a single-ray kernel"):
+            cellrt.Accelerator(scene.triangles, kind=kind, simd="auto")
+    assert cellrt.Accelerator(scene.triangles, kind="kd").stats.traversal == "packet"
+
+
 def test_bvh_traversals(case):
     scene, rays, hits, occluded = case
     for kind in ("bvh:wide", "bvh:paired", "bvh:stream", "bvh:packet"):
