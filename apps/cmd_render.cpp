@@ -272,12 +272,13 @@ Runner add_render(CLI::App& app) {
         if (!o->stats.empty()) {
             nlohmann::json j = {{"scene", scene.name},          {"triangles", scene.triangles.size()},
                                 {"width", ro.width},            {"height", ro.height},
-                                {"structure", st.name},         {"threads", ro.threads},
+                                {"structure", st.name},         {"threads", rs.workers.size()},
                                 {"packet", ro.packet},          {"primary_rays", rs.primary_rays},
                                 {"shading", to_string(shading.shading)}, {"secondary_rays", rs.secondary_rays},
                                 {"build_seconds", st.build_seconds},
                                 {"render_seconds", rs.seconds}, {"frame_seconds", frame_s},
                                 {"figures", nlohmann::json::object()}};
+            if (shading.shading == Shading::ao) j["ao_samples"] = shading.ao_samples;
             for (const auto& [k, v] : st.figures()) j["figures"][k] = v;
             // Each worker's share of the frame (docs/SCALING.md): the packets it traced, the time it
             // spent tracing them, and when it started and finished, from the frame's start.

@@ -414,6 +414,18 @@ TEST(Cli, StatsGiveTheTracingWithinTheFrame) {
     const double render = j.at("render_seconds").get<double>(), frame = j.at("frame_seconds").get<double>();
     EXPECT_GT(render, 0.0);
     EXPECT_GE(frame, render);
+    // The workers that traced, not the option's 0 (all cores), and AO's samples with AO only.
+    EXPECT_EQ(j.at("threads").get<std::size_t>(), j.at("workers").size());
+    EXPECT_GE(j.at("threads").get<std::size_t>(), 1u);
+    EXPECT_FALSE(j.contains("ao_samples"));
+    const auto [ao_text, ao_status] =
+        run_for_error({"render", "builtin:spheres?tris=500", "--size", "16x16", "-o", (dir.path / "ao.pfm").string(),
+                       "--shading", "ao", "--ao-samples", "3", "--threads", "2", "--stats", stats, "--overwrite"},
+                      dir.path);
+    ASSERT_EQ(ao_status, 0) << ao_text;
+    const nlohmann::json ao = nlohmann::json::parse(std::ifstream(stats));
+    EXPECT_EQ(ao.at("ao_samples").get<int>(), 3);
+    EXPECT_EQ(ao.at("threads").get<int>(), 2);
 }
 
 // --accel takes the configuration string the benchmarks, the C API and Python print: its traversal and
