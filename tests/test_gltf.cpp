@@ -233,6 +233,53 @@ TEST_F(GltfTest, ALargeMeshLoadsWithItsOwnCamera) {
     }
 }
 
+// Found by audit (2026-12-07): a rotation 1.0005 long scaled and skewed the mesh; a mirroring
+// transform kept the corners' order, so the front face turned clockwise.
+TEST_F(GltfTest, RotationsAreNormalisedAndMirrorsKeepTheFrontCounterClockwise) {
+    json doc = quad_document();
+    doc["nodes"][0]["rotation"] = {0, 0, 0, 1.0005};  // the identity, not quite unit
+    EXPECT_EQ(load_gltf(embedded(doc)).triangles, kQuad);
+    doc["nodes"][0].erase("rotation");
+    doc["nodes"][0]["scale"] = {-1, 1, 1};
+    const auto mirrored = load_gltf(embedded(doc)).triangles;
+    ASSERT_EQ(mirrored.size(), 2u);
+    EXPECT_EQ(mirrored[0], (Triangle{{0, 0, 0}, {-1, 1, 0}, {-1, 0, 0}}));
+    EXPECT_EQ(mirrored[1], (Triangle{{0, 0, 0}, {0, 1, 0}, {-1, 1, 0}}));
+    for (const Triangle& t : mirrored) EXPECT_GT(t.geometric_normal().z, 0.f);  // as the unmirrored quad's
+    doc["nodes"][0]["scale"] = {-1, -1, 1};  // a half turn: not a mirror
+    EXPECT_GT(load_gltf(embedded(doc)).triangles[0].geometric_normal().z, 0.f);
+}
+
+// What the reader does not apply is refused, not ignored, where it moves or adds vertices (found by
+// audit, 2026-12-07: instances dropped, a morph target's pose and a skin's joints ignored).
+TEST_F(GltfTest, GeometryTheReaderDoesNotApplyIsRefused) {
+    json doc = quad_document();
+    doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+    doc["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+    EXPECT_EQ(error(doc),
+              "requires the extension 'EXT_mesh_gpu_instancing', which this reader does not apply (it could change the "
+              "triangles)");
+    doc["extensionsUsed"] = {"KHR_materials_unlit"};
+    doc["extensionsRequired"] = {"KHR_materials_unlit"};  // appearance only
+    EXPECT_EQ(load_gltf(embedded(doc)).triangles, kQuad);
+
+    json morph = quad_document();
+    morph["meshes"][0]["primitives"][0]["targets"] = json::parse(R"([{"POSITION": 0}])");
+    morph["meshes"][0]["weights"] = {0.0};
+    EXPECT_EQ(load_gltf(embedded(morph)).triangles, kQuad);  // weight 0: the base pose
+    morph["meshes"][0]["weights"] = {1.0};
+    EXPECT_EQ(error(morph),
+              "node 0: mesh 0 ('quad') has morph targets with a weight other than 0, which this reader does not apply");
+    morph["nodes"][0]["weights"] = {0.0};  // the node's weights decide
+    EXPECT_EQ(load_gltf(embedded(morph)).triangles, kQuad);
+
+    json skin = quad_document();
+    skin["nodes"] = json::parse(R"([{"mesh": 0, "skin": 0}, {}])");
+    skin["scenes"][0]["nodes"] = {0, 1};
+    skin["skins"] = json::parse(R"([{"joints": [1]}])");
+    EXPECT_EQ(error(skin), "node 0: has a skin, which this reader does not apply");
+}
+
 TEST_F(GltfTest, BadFilesAreRefusedNamingThePartAtFault) {
     auto with = [](const char* pointer, json value) {
         json doc = quad_document();

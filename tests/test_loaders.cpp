@@ -97,11 +97,17 @@ TEST_F(LoaderTest, ObjSkipsGroupsUnknownStatementsCommentsAndBlankLines) {
                              "usemtl stone\n"
                              "v 0 0 0 1.0\n"  // optional w
                              "v\t1 0 0 # trailing comment\n"
-                             "vt 0.5 0.5\nvn 0 0 1\nvp 0.1\nl 1 2\ncstype bezier\nsomething unheard of\n"
+                             "vt 0.5 0.5\nvn 0 0 1\nvp 0.1\nl 1 2\np 1\nsomething unheard of\n"
                              "v +1 1 1e-50\n"  // a '+' sign; a value below float's range is zero
                              "#f 9 9 9\n"
                              "f 1 2 3 # trailing comment\n";
     EXPECT_EQ(load_obj(write("t.obj", text)), (std::vector<Triangle>{{kA, kB, kC}}));
+}
+
+// `fo` is OBJ's older name of `f`.
+TEST_F(LoaderTest, ObjReadsFoAsAFace) {
+    EXPECT_EQ(load_obj(write("t.obj", kSquareVertices + "f 1 2 3\nfo 1 3 4\n")),
+              (std::vector<Triangle>{{kA, kB, kC}, {kA, kC, kD}}));
 }
 
 TEST_F(LoaderTest, ObjAcceptsCrlfLineEndingsAndNoFinalNewline) {
@@ -145,6 +151,19 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
          ":5: face index 9223372036854775807 is out of range (the file has 4 vertices)"},
         {kSquareVertices + "f -9223372036854775808 1 2\n",
          ":5: face index -9223372036854775808 is out of range (4 vertices before it)"},
+        // Geometry the reader does not read is refused by name, not skipped; continued lines and CR
+        // line ends are named (found by audit, 2026-12-07: `call`, `surf` and a strip were dropped).
+        {kSquareVertices + "f 1 2 3\ncall more.obj\n", ":6: 'call' (statements run from another file or a shell) is "
+                                                        "not supported"},
+        {kSquareVertices + "cstype bezier\n", ":5: free-form geometry ('cstype') is not supported: only polygons (v "
+                                              "and f)"},
+        {kSquareVertices + "surf 0 1 0 1 1 2 3 4\n", ":5: free-form geometry ('surf') is not supported: only polygons "
+                                                     "(v and f)"},
+        {kSquareVertices + "f 1 2 \\\n 3 4\n", ":5: a line continued by '\\' is not supported: join it to the next line"},
+        {kSquareVertices + "g name \\ \r\nf 1 2 3\n", ":5: a line continued by '\\' is not supported: join it to the "
+                                                        "next line"},
+        {"v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", ":1: a carriage return inside the line: the file's lines end with CR "
+                                                    "alone (old Mac); convert them to LF or CRLF"},
     };
     for (const Case& c : cases) {
         const std::string path = write("bad.obj", c.text);
@@ -444,6 +463,10 @@ TEST_F(LoaderTest, PlyMalformedHeaderNamesFileAndLine) {
         {"ply\nformat ascii 1.0\n" + v3 + "end_header now\n", ":7: unexpected text after end_header"},
         {"ply\nformat ascii 1.0\nelement face 1\n" + kFaceList + "end_header\n",
          ":5: the header declares no element 'vertex'"},
+        // Found by audit (2026-12-07): a strip's triangles were dropped without a word.
+        {"ply\nformat ascii 1.0\n" + v3 + "element tristrips 1\nproperty list int int vertex_indices\nend_header\n",
+         ":7: element 'tristrips' holds vertex indices ('vertex_indices'), which this reader does not read: only "
+         "element 'face' makes triangles"},
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nend_header\n",
          ":3: element 'vertex' has no property 'z'"},
         {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float y\nproperty float z\nend_header\n",

@@ -67,6 +67,12 @@ Matrix multiply(const Matrix& a, const Matrix& b) {
     return m;
 }
 
+// The determinant of m's upper-left 3 x 3 block, whose sign says whether m mirrors.
+double determinant3(const Matrix& m) {
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+           m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
 // m * (x, y, z, w), as floats.
 Vec3 apply(const Matrix& m, double x, double y, double z, double w) {
     return {static_cast<float>(m[0] * x + m[4] * y + m[8] * z + m[12] * w),
@@ -93,6 +99,7 @@ public:
 
     GltfScene read() {
         parse();
+        check_required_extensions();
         const std::vector<int>& roots = default_scene_nodes();
         collect_instances(roots);
         std::size_t total = 0;
@@ -117,8 +124,13 @@ public:
                     fail(node_name(in.node) + ": its transform makes vertex " + std::to_string(i) + " of " +
                          mesh_name(in.mesh) + " non-finite");
             }
+            // A transform that mirrors (a negative determinant) makes the front faces clockwise (glTF
+            // 2.0, "Meshes"): the corners are swapped so that every triangle's front is
+            // counter-clockwise, as an unmirrored node's and an OBJ's are (found by audit, 2026-12-07).
+            const int second = determinant3(in.world) < 0.0 ? 2 : 1, third = 3 - second;
             for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
-                out.triangles.push_back({world[mesh.indices[t]], world[mesh.indices[t + 1]], world[mesh.indices[t + 2]]});
+                out.triangles.push_back(
+                    {world[mesh.indices[t]], world[mesh.indices[t + second]], world[mesh.indices[t + third]]});
         }
         out.camera = camera_;
         out.aspect_ratio = aspect_;
@@ -135,6 +147,38 @@ private:
 
     std::string node_name(int i) const { return named("node", static_cast<std::size_t>(i), model_.nodes[static_cast<std::size_t>(i)].name); }
     std::string mesh_name(int i) const { return named("mesh", static_cast<std::size_t>(i), model_.meshes[static_cast<std::size_t>(i)].name); }
+
+    // glTF 2.0 section 3.12: a loader must refuse an asset one of whose required extensions it does
+    // not support. Those that change only the appearance cannot change the triangles and are taken;
+    // any other (instancing, compression, quantization, ...) could (found by audit, 2026-12-07:
+    // EXT_mesh_gpu_instancing's copies were dropped without a word).
+    void check_required_extensions() const {
+        auto appearance_only = [](const std::string& e) {
+            for (const char* prefix : {"KHR_materials_", "KHR_texture_", "EXT_texture_"})
+                if (e.rfind(prefix, 0) == 0) return true;
+            return e == "KHR_lights_punctual" || e == "MSFT_texture_dds";
+        };
+        for (const std::string& e : model_.extensionsRequired)
+            if (!appearance_only(e))
+                fail("requires the extension '" + e + "', which this reader does not apply (it could change the "
+                     "triangles)");
+    }
+
+    // What the reader does not apply and will not ignore where it moves the vertices (found by audit,
+    // 2026-12-07): a skin (a skinned mesh follows its joints, not its node), and morph targets with a
+    // weight other than 0 (the node's weights, else the mesh's).
+    void check_deformations(int node, int mesh) const {
+        const tinygltf::Node& n = model_.nodes[static_cast<std::size_t>(node)];
+        if (n.skin >= 0) fail(node_name(node) + ": has a skin, which this reader does not apply");
+        const tinygltf::Mesh& m = model_.meshes[static_cast<std::size_t>(mesh)];
+        const std::vector<double>& weights = n.weights.empty() ? m.weights : n.weights;
+        bool targets = false;
+        for (const tinygltf::Primitive& p : m.primitives) targets = targets || !p.targets.empty();
+        for (const double w : weights)
+            if (targets && w != 0.0)
+                fail(node_name(node) + ": " + mesh_name(mesh) +
+                     " has morph targets with a weight other than 0, which this reader does not apply");
+    }
 
     void parse() {
         tinygltf::TinyGLTF loader;
@@ -200,10 +244,13 @@ private:
             m[10] = n.scale[2];
         }
         if (!n.rotation.empty()) {
-            const double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-            const double len = std::sqrt(x * x + y * y + z * z + w * w);
-            // glTF requires a unit quaternion; exporters write it to a few digits.
+            const double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
+                                         n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+            // glTF requires a unit quaternion; exporters write it to a few digits. Normalised, so that
+            // a length of 1.0005 neither scales nor skews the mesh (found by audit, 2026-12-07).
             if (std::fabs(len - 1.0) > 1e-3) fail(node_name(index) + ": rotation is not a unit quaternion");
+            const double x = n.rotation[0] / len, y = n.rotation[1] / len, z = n.rotation[2] / len,
+                         w = n.rotation[3] / len;
             const Matrix r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
                               2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
                               2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
@@ -239,6 +286,7 @@ private:
                 if (static_cast<std::size_t>(n.mesh) >= model_.meshes.size())
                     fail(node_name(index) + ": mesh " + std::to_string(n.mesh) + " does not exist (the file has " +
                          std::to_string(model_.meshes.size()) + " meshes)");
+                check_deformations(index, n.mesh);
                 instances_.push_back({index, n.mesh, world});
             }
             if (n.camera >= 0) take_camera(index, n.camera, world);

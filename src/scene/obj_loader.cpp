@@ -34,15 +34,44 @@ public:
             text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
             ++line_no;
             line_ = line_no;
+            // A carriage return before the line's end: old Mac line ends (CR alone), which would make
+            // the whole file one line.
+            if (const std::size_t cr = line.find('\r'); cr != std::string_view::npos && cr + 1 < line.size())
+                fail("a carriage return inside the line: the file's lines end with CR alone (old Mac); convert them to "
+                     "LF or CRLF", line_);
             if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
             const std::string_view keyword = next_token(line);
+            if (keyword.empty()) continue;
+            // A backslash at a line's end joins the next line to it (OBJ's continuation), which this
+            // reader does not do: the next line would be read as a statement of its own.
+            if (ends_with_backslash(line.empty() ? keyword : line))
+                fail("a line continued by '\\' is not supported: join it to the next line", line_);
             if (keyword == "v") parse_vertex(line);
-            else if (keyword == "f") parse_face(line);
+            else if (keyword == "f" || keyword == "fo") parse_face(line);  // `fo`: OBJ's older name of `f`
+            else refuse_geometry(keyword);
         }
         return resolve();
     }
 
 private:
+    static bool ends_with_backslash(std::string_view rest) {
+        while (!rest.empty() && (rest.back() == ' ' || rest.back() == '\t' || rest.back() == '\r')) rest.remove_suffix(1);
+        return !rest.empty() && rest.back() == '\\';
+    }
+
+    // Statements that make geometry this reader does not read: skipped, they would drop it without a
+    // word (found by audit, 2026-12-07). Every other statement (vt, vn, vp, l, p, g, o, s, usemtl,
+    // mtllib, ...) changes no triangle.
+    void refuse_geometry(std::string_view keyword) const {
+        if (keyword == "call" || keyword == "csh")
+            fail("'" + std::string(keyword) + "' (statements run from another file or a shell) is not supported", line_);
+        for (const char* free_form : {"cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole",
+                                      "scrv", "sp", "end", "con"})
+            if (keyword == free_form)
+                fail("free-form geometry ('" + std::string(keyword) + "') is not supported: only polygons (v and f)",
+                     line_);
+    }
+
     [[noreturn]] void fail(const std::string& what, std::size_t line) const {
         throw Error(path_ + ":" + std::to_string(line) + ": " + what);
     }

@@ -202,10 +202,19 @@ private:
             if (header_.elements[i].name == "vertex") header_.vertex_element = i;
             if (header_.elements[i].name == "face") header_.face_element = i;
         }
-        for (const Element& e : header_.elements)
+        for (const Element& e : header_.elements) {
             // A record must take at least a byte (binary) or a line (ASCII), so that a count cannot
             // make the reader loop over nothing.
             if (e.properties.empty() && e.count > 0) fail_at(e.line, "element '" + e.name + "' has no properties");
+            // Vertex indices in another element (`tristrips`, as some scanners write) are geometry
+            // this reader does not make triangles of: dropped, they were lost without a word (found
+            // by audit, 2026-12-07).
+            if (e.name != "face" && e.count > 0)
+                for (const char* indices : {"vertex_indices", "vertex_index"})
+                    if (property(e, indices))
+                        fail_at(e.line, "element '" + e.name + "' holds vertex indices ('" + indices +
+                                            "'), which this reader does not read: only element 'face' makes triangles");
+        }
         if (header_.vertex_element == SIZE_MAX) fail("the header declares no element 'vertex'");
         const Element& v = header_.elements[header_.vertex_element];
         const char* axes[3] = {"x", "y", "z"};
