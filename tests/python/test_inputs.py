@@ -108,7 +108,7 @@ def test_object_faces_in_range_are_accepted():
     ({"kind": 3}, "kind must be a str, got 3"),
     ({"kind": "kd+avx2"}, "pass the SIMD set as simd="),
     ({"kind": "kd@leaf_size=2"}, "parameters as params="),
-    ({"simd": None}, "simd must be a str, got None"),
+    ({"simd": 5}, "simd must be a str, got 5"),
     ({"threads": -1}, r"threads must be an integer in \[0, 1024\], got -1"),
     ({"threads": 2.5}, r"threads must be an integer in \[0, 1024\], got 2.5"),
     ({"threads": True}, "threads must be an integer"),
