@@ -441,11 +441,12 @@ PYBIND11_MODULE(cellrt, m) {
         "color", [](const PointLight& l) { return vec_tuple(l.color); },
         [](PointLight& l, py::handle value) {
             const Vec3 c = vec3_value(value, "color");
-            if (c.x < 0.f || c.y < 0.f || c.z < 0.f)
-                throw py::value_error("color = " + py::repr(vec_tuple(c)).cast<std::string>() + " has a negative channel");
+            if (std::string why = light_color_problem(c); !why.empty())
+                throw py::value_error("color = " + py::repr(vec_tuple(c)).cast<std::string>() + " " +
+                                      why.substr(std::string("the light color ").size()));
             l.color = c;
         },
-        "(r, g, b), each at least 0");
+        "(r, g, b), each from 0 to 1e30");
     refuse_second_init(camera);
     refuse_second_init(light);
 

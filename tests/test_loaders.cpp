@@ -805,6 +805,9 @@ TEST_F(LoaderTest, ViewFileRejectsWrongTypes) {
         // Found by audit (2026-12-07): accepted, a name of the wrong type replaced by the file's, and
         // a negative colour shading pixels below zero.
         {[](json& d) { d["light"]["color"] = {1, -1, 1}; }, "the light color has a negative channel"},
+        // Found by audit (2026-12-07): 3e38, a finite float, made a diffuse frame's pixels infinite.
+        {[](json& d) { d["light"]["color"] = {1, 3e38, 1}; },
+         "the light color has a channel above 1e+30, which the shading's sums could carry past float's range"},
         {[](json& d) { d["name"] = 5; }, "field 'name' must be a string"},
         {[](json& d) { d["name"] = nullptr; }, "field 'name' must be a string"},
     };

@@ -412,13 +412,69 @@ TEST(ImageSize, ParsedStrictlyAndLimitedBeforeAllocation) {
 }
 
 TEST(Render, ShadowOriginLeavesTheSurface) {
-    // A hit point far from the origin, pushed along its normal, must lie strictly on the normal side.
+    // A hit point pushed along its normal lies strictly on the normal side, by at least 2^-18 of the
+    // largest magnitude it was made from (2^-16 near the origin).
     for (const Vec3 p : {Vec3{1000.f, 2.f, -3.f}, Vec3{0.001f, 0.f, 0.f}, Vec3{-12345.f, 678.f, 0.5f}}) {
-        const Vec3 n{0.f, 1.f, 0.f};
-        const Vec3 o = offset_ray_origin(p, n);
-        EXPECT_GT(o.y, p.y);
+        const SurfacePoint sp{p, {0.f, 1.f, 0.f}, max_magnitude(p)};
+        const Vec3 o = offset_ray_origin(sp);
+        EXPECT_GE(o.y - p.y, std::fmax(max_magnitude(p) * 0x1p-18f, 0x1p-16f) * 0.999f);
         EXPECT_EQ(o.x, p.x);
     }
+}
+
+// Rays leaving a ground of two huge triangles never hit it (found by audit, 2026-12-07: with an
+// offset of 256 ulps of the hit point, AO and shadow rays leaving a ground 10 km wide near its middle
+// hit it again, about half of those under 45 degrees, since the test of a ray against a triangle errs
+// by ulps of the triangle's corners); and a light just inside a closed box lights nothing outside.
+TEST(Render, SecondaryRaysLeaveHugeTrianglesAndStopAtWallsNearTheLight) {
+    for (const float half : {5000.f, 450.f, 5.f}) {
+        const std::vector<Triangle> ground{{{-half, 0.f, -half}, {half, 0.f, -half}, {half, 0.f, half}},
+                                           {{-half, 0.f, -half}, {half, 0.f, half}, {-half, 0.f, half}}};
+        const auto accel = make_accelerator(ground, AccelConfig{"brute"});
+        std::vector<Ray> leaving;
+        for (int i = 0; i < 2000; ++i) {
+            // Camera rays from above onto points near the middle, each hit's ray leaving at an angle
+            // from grazing (0.01 rad) to steep.
+            const float x = 0.16f * static_cast<float>(i % 50) - 4.f, z = 0.2f * static_cast<float>(i / 50) - 4.f;
+            Ray down;
+            down.org = {x, 3.f, z};
+            down.dir = {0.01f, -1.f, 0.02f};
+            std::vector<Hit> hit(1);
+            accel->intersect(std::span(&down, 1), hit);
+            ASSERT_TRUE(hit[0].is_hit());
+            const SurfacePoint sp = surface_point(ground[hit[0].prim], down, hit[0]);
+            const float angle = 0.01f + 1.5f * static_cast<float>(i % 97) / 97.f, turn = 0.7f * static_cast<float>(i);
+            Ray out;
+            out.org = offset_ray_origin(sp);
+            out.dir = {std::cos(angle) * std::cos(turn), std::sin(angle), std::cos(angle) * std::sin(turn)};
+            leaving.push_back(out);
+            leaving.push_back(shadow_ray(sp, out.org + out.dir * 100.f));
+        }
+        std::vector<std::uint8_t> blocked(leaving.size());
+        accel->occluded(leaving, blocked);
+        EXPECT_EQ(std::count(blocked.begin(), blocked.end(), std::uint8_t{1}), 0) << "a ground " << 2 * half << " wide";
+    }
+    // A closed box 2 wide around the origin, the light 1e-3 inside its +x wall, a point 20 away (the
+    // shadow ray stops 2^-18 of 21 short of the light, 8e-5; 1e-4 of the distance was 2e-3).
+    const Vec3 lo{-1.f, -1.f, -1.f}, hi{1.f, 1.f, 1.f};
+    std::vector<Triangle> box;
+    for (int a = 0; a < 3; ++a)
+        for (const float side : {lo[a], hi[a]}) {
+            Vec3 c[4];
+            for (int k = 0; k < 4; ++k) {
+                c[k][a] = side;
+                c[k][(a + 1) % 3] = (k == 1 || k == 2) ? hi[(a + 1) % 3] : lo[(a + 1) % 3];
+                c[k][(a + 2) % 3] = (k >= 2) ? hi[(a + 2) % 3] : lo[(a + 2) % 3];
+            }
+            box.push_back({c[0], c[1], c[2]});
+            box.push_back({c[0], c[2], c[3]});
+        }
+    const auto closed = make_accelerator(box, AccelConfig{"brute"});
+    const SurfacePoint outside{{21.f, 0.3f, 0.2f}, {-1.f, 0.f, 0.f}, 21.f};
+    const Ray shadow = shadow_ray(outside, Vec3{0.999f, 0.f, 0.f});
+    std::vector<std::uint8_t> blocked(1);
+    closed->occluded(std::span(&shadow, 1), blocked);
+    EXPECT_EQ(blocked[0], 1) << "the light leaked out of the box";
 }
 
 }  // namespace

@@ -232,7 +232,7 @@ TEST_P(CoherentPackets, SameHits) {
     for (std::size_t i = 0; i < ref.rays.size(); ++i)
         if (ref.hits[i].is_hit()) {
             const SurfacePoint sp = surface_point(scene->triangles[ref.hits[i].prim], ref.rays[i], ref.hits[i]);
-            rays.push_back(shadow_ray(sp.position, sp.normal, scene->light.position));
+            rays.push_back(shadow_ray(sp, scene->light.position));
         }
     ref = test::stored_reference(scene->triangles, rays);
     const auto accel = make_accelerator(scene->triangles, parse_accel_config(config));

@@ -73,7 +73,7 @@ TEST(Workload, PrimaryRaysAreTheCamerasInPacketOrderAndEveryHitCastsOneShadowRay
             }
             ++hits;
             const SurfacePoint sp = surface_point(scene.triangles[expected_hits[i].prim], expected[i], expected_hits[i]);
-            expected_shadow.push_back(shadow_ray(sp.position, sp.normal, scene.light.position));
+            expected_shadow.push_back(shadow_ray(sp, scene.light.position));
             expected_primary.push_back(static_cast<std::uint32_t>(i));
             EXPECT_EQ(sh.normals[expected_shadow.size() - 1], sp.normal);
         }
@@ -114,7 +114,7 @@ TEST(Workload, AoRaysAreCosineWeightedAboutTheNormalWithAFixedReach) {
             ASSERT_EQ(i, ao.parent[k - k % n]) << "the rays of a hit are consecutive";
             const SurfacePoint sp = surface_point(scene.triangles[prim.hits[i].prim], prim.rays[i], prim.hits[i]);
             EXPECT_EQ(ao.normals[k], sp.normal);
-            EXPECT_EQ(ao.rays[k].org, offset_ray_origin(sp.position, sp.normal));
+            EXPECT_EQ(ao.rays[k].org, offset_ray_origin(sp));
             EXPECT_EQ(ao.rays[k].tnear, 0.f);
             EXPECT_EQ(ao.rays[k].tfar, reach);
             EXPECT_NEAR(length(ao.rays[k].dir), 1.f, 1e-5f);
@@ -147,7 +147,7 @@ TEST(Workload, DiffuseRaysAreAShadowRayAndABounceAndTheBouncesShadowRays) {
             const std::uint32_t i = bounce.parent[k];
             EXPECT_EQ(sh.parent[k], i);
             const SurfacePoint sp = surface_point(scene.triangles[prim.hits[i].prim], prim.rays[i], prim.hits[i]);
-            EXPECT_EQ(sh.rays[k].org, shadow_ray(sp.position, sp.normal, scene.light.position).org);
+            EXPECT_EQ(sh.rays[k].org, shadow_ray(sp, scene.light.position).org);
             EXPECT_EQ(bounce.rays[k].org, sh.rays[k].org);
             EXPECT_EQ(bounce.rays[k].tfar, kInfinity);
             EXPECT_GE(dot(bounce.rays[k].dir, sp.normal), -1e-6f);
@@ -156,7 +156,7 @@ TEST(Workload, DiffuseRaysAreAShadowRayAndABounceAndTheBouncesShadowRays) {
             EXPECT_EQ(bounce.hits[k], expected);
             if (!expected.is_hit()) continue;
             const SurfacePoint bp = surface_point(scene.triangles[expected.prim], bounce.rays[k], expected);
-            expected_bs.push_back(shadow_ray(bp.position, bp.normal, scene.light.position));
+            expected_bs.push_back(shadow_ray(bp, scene.light.position));
             EXPECT_EQ(bs.parent[expected_bs.size() - 1], k);
         }
         EXPECT_TRUE(same_rays(bs.rays, expected_bs)) << p;
@@ -209,7 +209,7 @@ TEST(Workload, AHitOnATriangleWithoutANormalFacesTheRay) {
     const SurfacePoint sp = surface_point(line, ray, hit);
     EXPECT_NEAR(length(sp.normal), 1.f, 1e-6f);
     EXPECT_LT(dot(sp.normal, ray.dir), 0.f);
-    const Ray shadow = shadow_ray(sp.position, sp.normal, Vec3{0.f, 5.f, 5.f});
+    const Ray shadow = shadow_ray(sp, Vec3{0.f, 5.f, 5.f});
     for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::isfinite(shadow.org[a]) && std::isfinite(shadow.dir[a]));
     // A direction too short to square (a valid ray: one component of at least 2^-126) and normals
     // whose length under- or overflows: still unit vectors, the latter the plane's own.

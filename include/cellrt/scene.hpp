@@ -22,6 +22,15 @@ struct PointLight {
     Vec3 color{1.f, 1.f, 1.f};
 };
 
+// The largest light colour channel: the shadings' sums of a few light terms (shading.hpp) stay
+// finite below it; 3e38, a finite float, filled a diffuse frame with infinite pixels (found by
+// audit, 2026-12-07).
+inline constexpr float kMaxLightChannel = 1e30f;
+
+// Why `color` cannot be a light's colour ("the light color has a negative channel", "... a channel
+// above 1e+30"), or "" where it can.
+std::string light_color_problem(const Vec3& color);
+
 struct Scene {
     std::string name;
     std::vector<Triangle> triangles;

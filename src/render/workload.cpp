@@ -162,14 +162,14 @@ void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, Trav
         if (!h.is_hit()) continue;
         const SurfacePoint sp = surface_point(scene_->triangles[h.prim], prim.rays[i], h);
         switch (frame_.shading.shading) {
-            case Shading::direct: b[RayKind::shadow].add(shadow_ray(sp.position, sp.normal, light), i, sp.normal); break;
+            case Shading::direct: b[RayKind::shadow].add(shadow_ray(sp, light), i, sp.normal); break;
             case Shading::ao:
                 for (int s = 0; s < frame_.shading.ao_samples; ++s)
                     b[RayKind::ao].add(hemisphere_ray(sp, b.pixel[i], static_cast<std::uint32_t>(s), kAoDims, frame_.ao_reach),
                                        i, sp.normal);
                 break;
             case Shading::diffuse:
-                b[RayKind::shadow].add(shadow_ray(sp.position, sp.normal, light), i, sp.normal);
+                b[RayKind::shadow].add(shadow_ray(sp, light), i, sp.normal);
                 b[RayKind::bounce].add(hemisphere_ray(sp, b.pixel[i], 0, kBounceDims, kInfinity), i, sp.normal);
                 break;
         }
@@ -190,7 +190,7 @@ void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, Trav
         const Hit& h = bounce.hits[j];
         if (!h.is_hit()) continue;
         const SurfacePoint sp = surface_point(scene_->triangles[h.prim], bounce.rays[j], h);
-        bounce_shadow.add(shadow_ray(sp.position, sp.normal, light), j, sp.normal);
+        bounce_shadow.add(shadow_ray(sp, light), j, sp.normal);
     }
     bounce_shadow.trace(accel, RayKind::bounce_shadow, secondary);
 }

@@ -61,16 +61,22 @@ std::string default_view_problem(const Scene& scene, bool camera_too) {
                        : ", for which the default light cannot be placed in float arithmetic");
 }
 
+std::string light_color_problem(const Vec3& color) {
+    // A colour past float's range (1e39 in a view file) would shade pixels infinite.
+    if (!is_finite(color)) return "the light color is not finite";
+    // Light is added, never taken away: a negative channel shaded pixels below zero.
+    if (color.x < 0.f || color.y < 0.f || color.z < 0.f) return "the light color has a negative channel";
+    if (color.x > kMaxLightChannel || color.y > kMaxLightChannel || color.z > kMaxLightChannel)
+        return "the light color has a channel above 1e+30, which the shading's sums could carry past float's range";
+    return "";
+}
+
 void validate_scene(const Scene& scene, const std::string& where) {
     if (scene.triangles.empty()) throw Error(where + ": the mesh has no triangles");
     try {
         check_finite(scene.triangles);
         if (!is_finite(scene.light.position)) throw Error("the light position is not finite");
-        // A colour past float's range (1e39 in a view file) would shade pixels infinite.
-        if (!is_finite(scene.light.color)) throw Error("the light color is not finite");
-        // Light is added, never taken away: a negative channel shaded pixels below zero.
-        if (scene.light.color.x < 0.f || scene.light.color.y < 0.f || scene.light.color.z < 0.f)
-            throw Error("the light color has a negative channel");
+        if (const std::string why = light_color_problem(scene.light.color); !why.empty()) throw Error(why);
         PinholeCamera(scene.camera, scene.width, scene.height);
     } catch (const Error& e) {
         throw Error(where + ": " + e.what());

@@ -315,6 +315,8 @@ def test_bad_scene_properties():
     refused(r"up = \(0.0, nan, 0.0\) is not finite", setattr, scene.camera, "up", (0, np.nan, 0))
     refused("color must hold real numbers", setattr, scene.light, "color", ("r", "g", "b"))
     refused(r"color = \(1.0, -1.0, 1.0\) has a negative channel", setattr, scene.light, "color", (1, -1, 1))
+    refused(r"color = \(1.0, 1.2676506002282294e\+30, 1.0\) has a channel above 1e\+30", setattr, scene.light,
+            "color", (1, 2.0**100, 1))
     refused(r"size\[1\] must be an integer", setattr, scene, "size", (5, 2.5))
     # The field of view is checked when set, as the vectors are, not first at render; 179.99999999
     # is 180 as a float32, the camera's type.
