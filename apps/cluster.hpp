@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <variant>
+#include <algorithm>
 #include <vector>
 
 #include "cellrt/error.hpp"
@@ -150,6 +151,35 @@ inline void agree(const std::string& mine, const std::string& name,
     together([&] { if (mine != leaders) throw Error(differs(mine, leaders)); }, name);
 }
 
+// The arguments parse() read, after the program's name.
+inline std::vector<std::string>& arguments_read() {
+    static std::vector<std::string> arguments;
+    return arguments;
+}
+
+// A sweep's ranks each run their share of one set of runs, which the leader writes as one result: a
+// rank started with another line (mpirun's `A : B` form) ran other runs, and the leader wrote
+// uninitialised rows for those it expected (found by audit, 2026-12-07). The line is compared but
+// for the options `local` and their values (where a machine keeps its copy of the scenes, say). The
+// frame of `render` is compared by what decides its pixels instead, as its ranks may differ in
+// structure and threads.
+inline void same_command_line(const std::string& what, const std::vector<std::string>& local = {}) {
+    std::string line;
+    const std::vector<std::string>& args = arguments_read();
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string name = args[i].substr(0, args[i].find('='));
+        if (std::find(local.begin(), local.end(), name) != local.end()) {
+            if (name == args[i]) ++i;  // its value, the next argument
+            continue;
+        }
+        line += (line.empty() ? "'" : " '") + args[i] + "'";
+    }
+    agree(line, "comparing the command lines", [&](const std::string& mine, const std::string& leaders) {
+        return "its command line (" + mine + ") differs from rank 0's (" + leaders + "): " + what +
+               " runs one command line on every rank";
+    });
+}
+
 // Parses the command line into `app` on every process and agrees on the outcome: -1 to go on, else
 // the exit status. --help and its kind print what they ask for (the leader speaks for all), status 0;
 // a refused line is bad input like any other, one line "PROGRAM: error: ..." naming the option,
@@ -157,6 +187,7 @@ inline void agree(const std::string& mine, const std::string& name,
 // alone is refused, or alone asks for --help (mpirun's `A : B` form), ends the job at once, named,
 // where the others used to wait for it until their time-out, or pair unlike collectives.
 inline int parse(CLI::App& app, int argc, char** argv) {
+    arguments_read().assign(argv + 1, argv + argc);
     std::optional<int> help;
     std::ostringstream help_out, help_err;
     std::string refused;

@@ -361,6 +361,7 @@ Runner add_cache_study(CLI::App& app) {
     return [o] {
         // Under MPI each step runs on every rank, a step that fails on one fails on all, and the runs
         // are shared among the ranks (cluster.hpp); rank 0 alone prints and writes.
+        cluster::same_command_line("cache-study");
         std::string csv_path, md_path;
         cluster::together([&] {
             checked_choices("--structures", o->structures, {"kd", "bih"});

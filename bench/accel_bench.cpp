@@ -126,6 +126,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
     cluster::add_bench_options(app);
     cluster::strict_numbers(app);
     if (const int status = cluster::parse(app, argc, argv); status >= 0) return status;
+    cluster::same_command_line("a sweep", {"--scenes-dir"});
     o.scenes_named = app.count("--scenes") > 0;
     cluster::together([&] {
         bench::check_configs(o.configs);

@@ -125,6 +125,12 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             EXPECT_NE(report.find("\"float\""), std::string::npos) << report;
             // Ranks on rank 0's machine (all here) write their pixels into its shared window.
             EXPECT_EQ(window_ranks(stats), ranks - 1) << report;
+            // Every rank's threads listed in rank order, those of a rank that traced no tile too.
+            const nlohmann::json j = nlohmann::json::parse(report);
+            std::size_t threads = 0;
+            for (const auto& r : j.at("ranks")) threads += r.at("threads").get<std::size_t>();
+            EXPECT_EQ(j.at("workers").size(), threads) << report;
+            EXPECT_EQ(j.at("threads").get<std::size_t>(), threads) << report;
         }
         // A PNG's pixels travel as its 8-bit bytes, made on each rank: the plain program's PNG.
         const fs::path png = dir.path / (name + "plain.png");
@@ -319,6 +325,25 @@ TEST_F(DistributedBench, ABadOptionIsOneMessage) {
     const fs::path lost = dir.path / "missing" / "results.json";
     expect_failure(shell(mpirun(2) + CELLRT_SCALING_MPI + " --json " + lost.string(), dir.path), out, "rank 0: ",
                    lost.string() + ": no folder " + lost.parent_path().string() + " to write it in", "cellrt_scaling");
+}
+
+// A sweep's ranks run one command line: a rank started with another (mpirun's `A : B`) ran other
+// runs, and the leader wrote uninitialised rows for the ones it expected (found by audit, 2026-12-07).
+TEST_F(Distributed, ASweepsRanksWithAnotherCommandLineAreRefused) {
+    const fs::path out = dir.path / "study";
+    const std::string study = mpi + std::string(" cache-study ") + kScene + " --size 32x32 -o " + out.string();
+    const Outcome o = shell(mpirun(2) + study + " : -np 1 " + study + " --structures kd", dir.path);
+    expect_failure(o, out, "rank 2: ", "its command line ('cache-study' ");
+    EXPECT_NE(o.err.find("): cache-study runs one command line on every rank"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(DistributedBench, ASweepsRanksWithAnotherCommandLineAreRefused) {
+    const fs::path results = dir.path / "results.json";
+    const std::string bench = std::string(CELLRT_SCALING_MPI) + " --scenes 'builtin:city?tris=300' --size 8x8 "
+                              "--repeats 1 --configs kd --json " + results.string();
+    expect_failure(shell(mpirun(1) + bench + " : -np 1 " + bench + " --shading ao", dir.path), results, "rank 1: ",
+                   "a sweep runs one command line on every rank", "cellrt_scaling");
 }
 
 TEST_F(Distributed, ARankWhoseSceneFailsEndsEveryRank) {

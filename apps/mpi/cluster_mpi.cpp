@@ -42,7 +42,8 @@ void add_timeout_option(CLI::App& cmd, std::chrono::seconds fallback) {
            "--rank-timeout",
            // A NaN or an infinity never gets here: strict_numbers (cluster.hpp) refuses them first.
            [](double s) { session().set_timeout(std::chrono::milliseconds(static_cast<long long>(s * 1e3))); },
-           "Seconds a rank waits for another before it ends the job with a message (default " +
+           "Seconds a rank waits for another before it ends the job with a message: the longest a tile or a "
+           "step on one rank (a build, a load) may take beyond the others' (default " +
                std::to_string(fallback.count()) + ")")
         ->check(CLI::Range(0.1, static_cast<double>(kLongestRankTimeout.count())));
 }

@@ -58,7 +58,7 @@ void Session::poll_ending(double waited, const std::string& what) const {
     const double limit = static_cast<double>(timeout_.count()) / 1e3 * (leader() ? 1.0 : 2.0);
     if (waited > limit)
         abort("no answer to " + what + " within " + (leader() ? "" : "twice ") + timeout_text() +
-              " (a rank stopped answering; --rank-timeout)");
+              " (a rank stopped answering, or its step took longer than --rank-timeout)");
 }
 
 void Session::abort(const std::string& message) const {

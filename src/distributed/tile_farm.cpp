@@ -458,7 +458,7 @@ RankLoad master(const Session& session, const Scene& scene, const Accelerator& a
             if (outstanding[r] > 0 && now - heard[r] > timeout)
                 session.abort("rank " + std::to_string(r) + " has returned no tile for " + session.timeout_text() +
                               ", " + std::to_string(outstanding[r]) +
-                              " of its tiles outstanding (it stopped answering; --rank-timeout)");
+                              " of its tiles outstanding (it stopped answering, or its tiles take longer than --rank-timeout)");
         if (options.progress && gathered != reported) options.progress(reported = gathered, all_packets);
         if (completed == 0) std::this_thread::sleep_for(poll_interval());
     }
@@ -561,7 +561,13 @@ void render_tiles(const Session& session, const Scene& scene, const Accelerator&
         stats->primary_rays = static_cast<std::uint64_t>(options.width) * options.height;
         for (const RankLoad& l : gathered) {
             stats->secondary_rays += l.secondary_rays;
-            for (const WorkerLoad& w : l.workers) stats->workers.push_back({w.packets, w.busy_seconds, 0.0, l.seconds});
+            // Every rank's threads, in rank order, a rank's `threads` entries each: a rank without a
+            // tile had none listed, so the list could not be matched to the ranks (found by audit,
+            // 2026-12-07).
+            for (std::size_t w = 0; w < std::max<std::size_t>(l.threads, l.workers.size()); ++w)
+                stats->workers.push_back(w < l.workers.size()
+                                             ? WorkerLoad{l.workers[w].packets, l.workers[w].busy_seconds, 0.0, l.seconds}
+                                             : WorkerLoad{0, 0.0, 0.0, l.seconds});
         }
     }
     if (loads) *loads = std::move(gathered);
