@@ -411,6 +411,34 @@ TEST(ImageSize, ParsedStrictlyAndLimitedBeforeAllocation) {
     std::filesystem::remove_all(dir);
 }
 
+// Found by audit (2026-12-07): a scene made in code with a NaN or negative light colour rendered NaN
+// or negative pixels, and render() from a progress callback waited for ever.
+TEST(Render, ABadLightOrAFrameInsideAFrameIsRefused) {
+    Scene scene = make_builtin_scene("builtin:spheres?tris=200");
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"kd"});
+    RenderOptions options;
+    options.width = options.height = 16;
+    scene.light.color = {std::nanf(""), 1.f, 1.f};
+    EXPECT_EQ(test::error_of([&] { render(scene, *accel, options); }), "the light color is not finite");
+    scene.light.color = {-5.f, -5.f, -5.f};
+    EXPECT_EQ(test::error_of([&] { render(scene, *accel, options); }), "the light color has a negative channel");
+    scene.light.color = {1.f, 1.f, 1.f};
+    scene.light.position = {std::nanf(""), 0.f, 0.f};
+    EXPECT_EQ(test::error_of([&] { render(scene, *accel, options); }), "the light position is not finite");
+    scene.light.position = {0.f, 10.f, 0.f};
+    const std::string nested = "a frame was started from inside a frame (a progress callback or a packet's trace): "
+                               "frames run one at a time on the process's one team of workers";
+    for (const Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        for (const unsigned threads : {1u, 2u}) {
+            options.dispatch = d;
+            options.threads = threads;
+            options.progress = [&](std::size_t, std::size_t) { render(scene, *accel, RenderOptions{}); };
+            EXPECT_EQ(test::error_of([&] { render(scene, *accel, options); }), nested) << threads;
+        }
+    options.progress = nullptr;
+    EXPECT_EQ(render(scene, *accel, options).width, 16);  // the team still works
+}
+
 TEST(Render, ShadowOriginLeavesTheSurface) {
     // A hit point pushed along its normal lies strictly on the normal side, by at least 2^-18 of the
     // largest magnitude it was made from (2^-16 near the origin).

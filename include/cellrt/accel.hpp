@@ -56,7 +56,9 @@ std::string format_accel_config(const AccelConfig& config);
 // BIH only, "kd" (docs/GPU.md: the faster of the two there).
 AccelConfig default_accel_config(const std::string& device = "cpu");
 
-// Kinds built into this binary ("brute", "kd", "bih", and "embree" where Embree 3 was found).
+// Kinds built into this binary ("brute", "kd", "bih", "bvh", "auto", and "embree" where Embree 3 was
+// found). Thread safety: every function of this header may be called from any number of threads at
+// once; builds run at once are independent.
 std::vector<std::string> accelerator_kinds();
 
 // The build parameters of `kind` (empty for none) and its single-ray traversals, the default first.

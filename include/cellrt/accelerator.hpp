@@ -7,7 +7,8 @@
 // threads on one accelerator of any kind (each thread of the local-store model is a worker with a
 // local store of its own), and every call gets the answers it gets alone. Calls that run at once must
 // not share a TraversalCounters (it is summed unsynchronised) nor write overlapping result spans; a
-// local-store accelerator's statistics are read between traces (local_store.hpp). Destroying an
+// local-store accelerator's statistics are read between traces (the `cellrt render --local-store`
+// model, src/localstore/, not a public header). Destroying an
 // accelerator while a call runs on it is undefined, as for any object. What an accelerator keeps of
 // the triangles it was built over: cellrt/accel.hpp.
 #pragma once

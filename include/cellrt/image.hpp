@@ -70,7 +70,7 @@ void check_image_size(int width, int height);
 // throws cellrt::Error naming `what` (an option, a field) otherwise.
 std::pair<int, int> parse_image_size(const std::string& what, const std::string& text);
 
-// The sRGB transfer function applied to one linear channel, clamped to [0, 1].
+// The sRGB transfer function applied to one linear channel, clamped to [0, 1] (NaN as 0).
 float linear_to_srgb(float linear);
 
 }  // namespace cellrt

@@ -97,9 +97,10 @@ unsigned worker_count(const ScheduleOptions& options);
 
 // Traces every packet of `grid` into `image` (which must be grid.width x grid.height); when `loads`
 // is given, it receives one WorkerLoad per worker. Returns false when cancelled before all packets
-// were traced. `trace` runs on every worker at once (on packets of its own) and must not call
-// run_packets: frames run one at a time on the process's one team of worker threads, so a second
-// caller waits for the first. The first exception `trace` throws on any worker stops the others at
+// were traced. `trace` runs on every worker at once (on packets of its own); frames run one at a
+// time on the process's one team of worker threads, so a second caller waits for the first, and a
+// frame started from inside one (`trace` or a progress callback calling run_packets or render) is
+// refused with cellrt::Error, where it waited for ever. The first exception `trace` throws on any worker stops the others at
 // their next packet and is rethrown here once all have stopped.
 bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
                  std::vector<WorkerLoad>* loads = nullptr);

@@ -40,7 +40,7 @@ std::string encode_pfm(const Image& image) {
 }  // namespace
 
 float linear_to_srgb(float linear) {
-    const float c = std::clamp(linear, 0.f, 1.f);
+    const float c = linear > 0.f ? std::fmin(linear, 1.f) : 0.f;  // NaN as 0, as the docs say
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
 }
 

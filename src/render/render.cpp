@@ -104,6 +104,11 @@ struct FrameRenderer::State {
 FrameRenderer::FrameRenderer(const Scene& scene, const Accelerator& accel, const RenderOptions& options)
     : state_(std::make_unique<State>(State{scene, accel, options, PinholeCamera(scene.camera, options.width,
                                                                                   options.height), {}, {}})) {
+    // The light as validate_scene checks it (a Scene made in code need not have passed there): a NaN
+    // or negative colour shaded NaN or negative pixels, a NaN position no light at all (found by
+    // audit, 2026-12-07).
+    if (!is_finite(scene.light.position)) throw Error("the light position is not finite");
+    if (const std::string why = light_color_problem(scene.light.color); !why.empty()) throw Error(why);
     ScheduleOptions& schedule = state_->schedule;
     schedule.dispatch = options.dispatch;
     schedule.workers = options.threads;

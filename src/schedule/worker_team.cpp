@@ -33,6 +33,10 @@ T wait_for_change(const std::atomic<T>& value, T old, std::chrono::microseconds 
     return value.load(std::memory_order_acquire);
 }
 
+// Whether this thread is running a job of the team: a run started from there (a packet's trace, a
+// render's progress callback calling render or run_packets) would wait for the team it is part of.
+thread_local bool t_in_job = false;
+
 }  // namespace
 
 WorkerTeam::~WorkerTeam() {
@@ -48,6 +52,11 @@ WorkerTeam::~WorkerTeam() {
 }
 
 void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const std::function<void(unsigned)>& job) {
+    // Found by audit (2026-12-07): render() from a progress callback, or run_packets from a trace,
+    // waited for ever.
+    if (t_in_job)
+        throw Error("a frame was started from inside a frame (a progress callback or a packet's trace): frames run "
+                    "one at a time on the process's one team of workers");
     std::lock_guard lock(run_mutex_);
     while (threads_.size() + 1 < n) {
         // A new thread's signal starts at 0 and the thread waits for it to change: the first run it
@@ -104,9 +113,12 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
 
 // An exception must not leave a team thread (that would be std::terminate): it becomes the run's.
 void WorkerTeam::run_job(unsigned j) {
+    t_in_job = true;
     try {
         (*job_)(j);
+        t_in_job = false;
     } catch (...) {
+        t_in_job = false;
         std::lock_guard lock(failure_mutex_);
         if (!failure_) failure_ = std::current_exception();
     }
