@@ -91,7 +91,10 @@ public:
     virtual ~Accelerator() = default;
 
     // Closest hit of each ray under the hit rule of ray.hpp. Throws cellrt::Error when hits.size()
-    // differs from rays.size() (checked once per call, before any ray is traced).
+    // differs from rays.size() (checked once per call, before any ray is traced), and, for Embree,
+    // for a ray outside its domain (a negative tnear, a component beyond 1.844e18: docs/EMBREE.md),
+    // after which `hits` may be partly written; an exception from the structure (a GPU's failure)
+    // may leave it so too.
     void intersect(std::span<const Ray> rays, std::span<Hit> hits, TraversalCounters* counters = nullptr) const;
 
     // Any hit: occluded[i] = 1 when some triangle is hit with tnear <= t <= tfar, else 0. Throws
