@@ -34,6 +34,11 @@ int run(int argc, char** argv) {
             if (cli::cluster::ranks() > 1 && (chosen == 1 || chosen == 2))
                 throw Error(std::string(kNames[chosen]) + " runs in one process: run it with cellrt, not under mpirun");
         }, "choosing the command");
+        // Ranks started with other commands (mpirun's `A : B`) would pair unlike collectives (found by
+        // review, 2026-12-07).
+        cli::cluster::agree(kNames[chosen], "comparing the commands", [](const std::string& mine, const std::string& leaders) {
+            return "it runs " + mine + ", rank 0 " + leaders;
+        });
         return runners.at(chosen)();
     } catch (const Error& e) {
         cli::cluster::print_error(e);

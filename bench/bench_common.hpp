@@ -84,7 +84,7 @@ inline std::optional<std::string> scene_spec(const std::string& scenes_dir, cons
 
 // Refuses, before any run, a --configs entry this binary cannot read: a malformed string, a kind
 // cellrt does not have (Embree, which a build may lack, is skipped later instead: built_in), a
-// traversal its kind does not have.
+// traversal its kind does not have, a tree's kernel named with SIMD packets (names_replaced_traversal).
 inline void check_configs(const std::vector<std::string>& configs) {
     const auto kinds = accelerator_kinds();
     for (const std::string& text : configs) {
@@ -95,6 +95,9 @@ inline void check_configs(const std::vector<std::string>& configs) {
             if (!c.traversal.empty() && std::find(traversals.begin(), traversals.end(), c.traversal) == traversals.end())
                 throw Error("unknown traversal '" + c.traversal + "' of " + c.kind + " (choose one of: " +
                             detail::join_names(traversals) + ")");
+            if (names_replaced_traversal(c))
+                throw Error("names a single-ray kernel ('" + c.traversal + "') and SIMD packets ('" + c.simd +
+                            "'), which would replace it: leave one of them out");
         } catch (const Error& e) {
             throw Error("--configs '" + text + "': " + e.what());
         }

@@ -39,6 +39,9 @@ expect("--builds: '010' is not a whole number in decimal digits (see --help)" ${
 expect("--builds: '-1' is not a whole number in decimal digits (see --help)" ${BENCH} ${small} --configs kd --builds -1)
 expect("The following argument was not expected: --bogus (see --help)" ${SCALING} ${small} --configs kd --bogus)
 expect("--configs names 'kd' twice" ${BENCH} ${small} --configs kd kd)
+# A tree's kernel with SIMD packets, which replace it: refused before the sweep, not at its build.
+expect("--configs 'kd:rec+auto': names a single-ray kernel ('rec') and SIMD packets ('auto'), which would replace it: leave one of them out"
+       ${SCALING} ${small} --configs kd+auto kd:rec+auto)
 expect("--packets names '8' twice" ${SCALING} ${small} --configs kd --packets 8 8)
 expect("${WORK}/mine.json: file exists (pass --overwrite to replace it)"
        ${BENCH} ${small} --configs kd --json ${WORK}/mine.json)

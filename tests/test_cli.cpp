@@ -236,6 +236,9 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     fs::create_directory(linked);
     fs::create_symlink(good_view, fs::path(linked) / "cache_study.csv");
     const std::string twin = (dir.path / "twin.json").string();
+    const std::string gltf = (dir.path / "tri.gltf").string(), bin = (dir.path / "tri.bin").string();
+    std::ofstream(gltf) << "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"tri.bin\", \"byteLength\": 36}]}";
+    std::ofstream(bin) << std::string(36, '\0');
     {
         std::ifstream in(good_view);
         const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -304,6 +307,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         // (found by audit, 2026-12-07); two view files of one name would be one in the results.
         {{"render", good_view, "-o", out, "--stats", tri, "--overwrite"},
          "--stats " + tri + " names the mesh " + tri + ", which it would replace"},
+        {{"render", gltf, "-o", out, "--stats", bin, "--overwrite"},
+         "--stats " + bin + " names the glTF buffer " + bin + ", which it would replace"},
         {{"cache-study", good_view, "--out", linked, "--overwrite"},
          "--out " + linked + "/cache_study.csv names the scene " + good_view + ", which it would replace"},
         {{"cache-study", good_view, twin, "--out", study, "--structures", "kd", "--traversals", "branchless", "--access",

@@ -327,6 +327,21 @@ TEST_F(DistributedBench, ABadOptionIsOneMessage) {
                    lost.string() + ": no folder " + lost.parent_path().string() + " to write it in", "cellrt_scaling");
 }
 
+// --stats lists every rank's threads in rank order, those of ranks that traced no tile too (one tile
+// among three ranks; found by audit, 2026-12-07: they were left out).
+TEST_F(Distributed, StatsListEveryRanksWorkers) {
+    const fs::path out = dir.path / "one.pfm", stats = dir.path / "one.json";
+    const Outcome o = shell(mpirun(3) + mpi + " render " + kScene + " --size 16x16 --tile 16 --threads 1 -o " +
+                                out.string() + " --stats " + stats.string(), dir.path);
+    ASSERT_EQ(o.status, 0) << o.err;
+    const nlohmann::json j = nlohmann::json::parse(read(stats));
+    std::size_t tiles = 0;
+    for (const auto& r : j.at("ranks")) tiles += r.at("tiles").get<std::size_t>();
+    EXPECT_EQ(tiles, 1u);
+    EXPECT_EQ(j.at("workers").size(), 3u) << j.dump();
+    EXPECT_EQ(j.at("threads").get<std::size_t>(), 3u);
+}
+
 // A sweep's ranks run one command line: a rank started with another (mpirun's `A : B`) ran other
 // runs, and the leader wrote uninitialised rows for the ones it expected (found by audit, 2026-12-07).
 TEST_F(Distributed, ASweepsRanksWithAnotherCommandLineAreRefused) {

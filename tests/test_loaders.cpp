@@ -163,7 +163,7 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
         {kSquareVertices + "g name \\ \r\nf 1 2 3\n", ":5: a line continued by '\\' is not supported: join it to the "
                                                         "next line"},
         {"v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", ":1: a carriage return inside the line: the file's lines end with CR "
-                                                    "alone (old Mac); convert them to LF or CRLF"},
+                                                    "alone (old Mac) or a CR doubled before LF; convert them to LF or CRLF"},
     };
     for (const Case& c : cases) {
         const std::string path = write("bad.obj", c.text);

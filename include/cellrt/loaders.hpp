@@ -54,9 +54,10 @@ std::vector<Triangle> load_mesh(const std::string& path);
 Scene load_view_file(const std::string& path);
 
 // The files loading the scene `spec` (load_scene's argument) reads, as (what, path), so that a
-// program can refuse an output that would replace one of them before any work: ("scene", spec) and,
-// for a view file, ("mesh", the mesh it names); none for a built-in scene. A view file that cannot
-// be read as one gives itself alone (loading it names what is wrong).
+// program can refuse an output that would replace one of them before any work: ("scene", spec); for
+// a view file, ("mesh", the mesh it names); for a .gltf file, itself or a view file's mesh, ("glTF
+// buffer", each external buffer it names, its URI as written); none for a built-in scene. A file that
+// cannot be read as JSON gives no more (loading it names what is wrong).
 std::vector<std::pair<std::string, std::string>> scene_files(const std::string& spec);
 
 }  // namespace cellrt

@@ -46,8 +46,8 @@ struct RenderStats {
 // (light_color_problem, a non-finite position), packet edge, worker count or AO sample count, when
 // cancelled, or with the first exception a worker's packet threw (the other workers stop at their next
 // packet). render() may be called from several threads; their frames are traced one after another
-// (every frame runs on the process's one team of workers), and one called from inside a frame (from
-// `progress`) is refused.
+// (every frame runs on the process's one team of workers), and one called from inside a CPU frame
+// (from `progress`) is refused.
 // Given a device accelerator (cellrt/device.hpp) the frame is made on the device instead, one GPU
 // thread a pixel (DeviceAccelerator::render_frame), with the same pixels bit for bit; the packet
 // edge, workers, dispatch and pinning then play no part, and progress is reported once, at the end.

@@ -183,6 +183,8 @@ void check_output_folder(const std::string& option, const std::string& path) {
         if (::mkdir(missing.c_str(), 0700) == 0) ::rmdir(missing.c_str());
         else if (const int error = errno; error != EEXIST)
             throw Error(named + ": cannot make a folder in " + at.string() + " (" + std::strerror(error) + ")");
+        else if (!fs::is_directory(missing, ec))  // a link to nothing, or a file made meanwhile
+            throw Error(named + ": " + missing.string() + " is in the way of the folder (a link to nothing?)");
     }
 }
 

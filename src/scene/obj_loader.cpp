@@ -37,8 +37,8 @@ public:
             // A carriage return before the line's end: old Mac line ends (CR alone), which would make
             // the whole file one line.
             if (const std::size_t cr = line.find('\r'); cr != std::string_view::npos && cr + 1 < line.size())
-                fail("a carriage return inside the line: the file's lines end with CR alone (old Mac); convert them to "
-                     "LF or CRLF", line_);
+                fail("a carriage return inside the line: the file's lines end with CR alone (old Mac) or a CR doubled "
+                     "before LF; convert them to LF or CRLF", line_);
             if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
             const std::string_view keyword = next_token(line);
             if (keyword.empty()) continue;
@@ -66,7 +66,7 @@ private:
         if (keyword == "call" || keyword == "csh")
             fail("'" + std::string(keyword) + "' (statements run from another file or a shell) is not supported", line_);
         for (const char* free_form : {"cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole",
-                                      "scrv", "sp", "end", "con"})
+                                      "scrv", "sp", "end", "con", "bsp", "bzp", "cdc", "cdp", "res"})
             if (keyword == free_form)
                 fail("free-form geometry ('" + std::string(keyword) + "') is not supported: only polygons (v and f)",
                      line_);

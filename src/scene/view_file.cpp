@@ -195,14 +195,36 @@ private:
 
 Scene load_view_file(const std::string& path) { return ViewReader(path).read(); }
 
+namespace {
+
+// The external buffers a .gltf file names (`"uri": "mesh.bin"`, beside it), as (what, path); none for
+// data URIs, a .glb or a file that cannot be read as JSON (loading it says why).
+void add_gltf_buffers(const std::string& gltf, std::vector<std::pair<std::string, std::string>>& files) {
+    if (lower_extension(gltf) != ".gltf") return;
+    try {
+        const json doc = json::parse(detail::read_file(gltf));
+        if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return;
+        for (const json& b : doc["buffers"])
+            if (b.is_object() && b.contains("uri") && b["uri"].is_string() && b["uri"].get<std::string>().rfind("data:", 0) != 0)
+                files.emplace_back("glTF buffer", (std::filesystem::path(gltf).parent_path() / b["uri"].get<std::string>()).string());
+    } catch (const std::exception&) {
+    }
+}
+
+}  // namespace
+
 std::vector<std::pair<std::string, std::string>> scene_files(const std::string& spec) {
     if (spec.empty() || spec.rfind("builtin:", 0) == 0) return {};
     std::vector<std::pair<std::string, std::string>> files{{"scene", spec}};
+    add_gltf_buffers(spec, files);
     if (lower_extension(spec) != ".json") return files;
     try {
         const json doc = json::parse(detail::read_file(spec), nullptr, true, /*ignore_comments=*/true);
-        if (doc.is_object() && doc.contains("mesh") && doc["mesh"].is_string())
-            files.emplace_back("mesh", (std::filesystem::path(spec).parent_path() / doc["mesh"].get<std::string>()).string());
+        if (doc.is_object() && doc.contains("mesh") && doc["mesh"].is_string()) {
+            const std::string mesh = (std::filesystem::path(spec).parent_path() / doc["mesh"].get<std::string>()).string();
+            files.emplace_back("mesh", mesh);
+            add_gltf_buffers(mesh, files);
+        }
     } catch (const std::exception&) {
         // Not a view file one can read: loading it says why.
     }

@@ -16,7 +16,7 @@ for r in rows:
               "stall_cycles"):
         r[k] = int(r[k])
     for k in ("node_hit_ratio", "tri_hit_ratio", "cycles_per_ray", "wall_s"):
-        r[k] = float(r[k])
+        r[k] = float(r[k]) if r[k] else float("nan")  # empty: a cache the sampled rays never read
 
 SCENES = ["teapot", "bunny", "sponza", "sibenik"]
 STUDY_NODE = {"kd": "128x128", "bih": "256x64"}
