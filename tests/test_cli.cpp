@@ -235,6 +235,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
     const std::string tri = (dir.path / "tri.obj").string(), linked = (dir.path / "linked").string();
     fs::create_directory(linked);
     fs::create_symlink(good_view, fs::path(linked) / "cache_study.csv");
+    const std::string dangling = (dir.path / "dangling").string();  // a link to nothing as --out
+    fs::create_symlink(dir.path / "nothing" / "here", dangling);
     const std::string twin = (dir.path / "twin.json").string();
     const std::string gltf = (dir.path / "tri.gltf").string(), bin = (dir.path / "tri.bin").string();
     std::ofstream(gltf) << "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"tri.bin\", \"byteLength\": 36}]}";
@@ -315,6 +317,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
           "sync", "--sweeps", "node"},
          twin + " and " + good_view + " are both the scene 'good', and the results name their rows by scene: give one "
                                       "view file another \"name\""},
+        {{"cache-study", good_view, "--out", dangling}, "--out '" + dangling + "': " + dangling +
+                                                         " is in the way of the folder (a link to nothing?)"},
         {{"cache-study", (dir.path / "missing.obj").string(), "--out", study},
          (dir.path / "missing.obj").string() + ": no such file"},
         // Integers in decimal digits only: CLI11 read `010` as 8, `0x2` as 2, " 4" as 4 and "" as 0

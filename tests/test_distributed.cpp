@@ -353,6 +353,15 @@ TEST_F(Distributed, ASweepsRanksWithAnotherCommandLineAreRefused) {
     EXPECT_FALSE(fs::exists(out));
 }
 
+// Ranks started with other commands would pair unlike collectives (found by review, 2026-12-07).
+TEST_F(Distributed, RanksRunningOtherCommandsAreRefused) {
+    const fs::path out = dir.path / "other.png";
+    expect_failure(shell(mpirun(1) + mpi + " cache-study " + kScene + " --size 16x16 -o " + (dir.path / "s").string() +
+                             " : -np 1 " + mpi + " render " + kScene + " --size 16x16 -o " + out.string(),
+                         dir.path),
+                   out, "rank 1: ", "it runs render, rank 0 cache-study");
+}
+
 TEST_F(DistributedBench, ASweepsRanksWithAnotherCommandLineAreRefused) {
     const fs::path results = dir.path / "results.json";
     const std::string bench = std::string(CELLRT_SCALING_MPI) + " --scenes 'builtin:city?tris=300' --size 8x8 "

@@ -159,6 +159,9 @@ TEST_F(LoaderTest, ObjMalformedLinesNameFileAndLine) {
                                               "and f)"},
         {kSquareVertices + "surf 0 1 0 1 1 2 3 4\n", ":5: free-form geometry ('surf') is not supported: only polygons "
                                                      "(v and f)"},
+        {kSquareVertices + "bzp 1 2 3 4\n", ":5: free-form geometry ('bzp') is not supported: only polygons (v and f)"},
+        {kSquareVertices + "f 1 2 3\r\r\n", ":5: a carriage return inside the line: the file's lines end with CR alone "
+                                             "(old Mac) or a CR doubled before LF; convert them to LF or CRLF"},
         {kSquareVertices + "f 1 2 \\\n 3 4\n", ":5: a line continued by '\\' is not supported: join it to the next line"},
         {kSquareVertices + "g name \\ \r\nf 1 2 3\n", ":5: a line continued by '\\' is not supported: join it to the "
                                                         "next line"},

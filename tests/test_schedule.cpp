@@ -249,6 +249,26 @@ TEST(Schedule, AProgressCallbackThatThrowsEndsTheFrameWithItsException) {
         }
 }
 
+// A frame started from a packet's trace (found by audit, 2026-12-07: it waited for ever) is refused,
+// under both dispatch modes and on one worker too, and the team goes on.
+TEST(Schedule, AFrameStartedFromATraceIsRefused) {
+    const PacketGrid grid(32, 32, 8);
+    for (const Dispatch d : {Dispatch::pull, Dispatch::mailbox})
+        for (const unsigned workers : {1u, 2u}) {
+            ScheduleOptions o;
+            o.dispatch = d;
+            o.workers = workers;
+            Image image(32, 32), inner(32, 32);
+            const PacketTracer fill = [](unsigned, const PixelRect&, std::span<Vec3> c) { std::fill(c.begin(), c.end(), Vec3(1.f)); };
+            const PacketTracer nested = [&](unsigned, const PixelRect&, std::span<Vec3>) { run_packets(grid, o, inner, fill); };
+            EXPECT_EQ(test::error_of([&] { run_packets(grid, o, image, nested); }),
+                      "a frame was started from inside a frame (a progress callback or a packet's trace): frames run one "
+                      "at a time on the process's one team of workers")
+                << to_string(d) << ", " << workers;
+            EXPECT_TRUE(run_packets(grid, o, image, fill)) << to_string(d) << ", " << workers;
+        }
+}
+
 // The team behind both dispatch modes: every job index runs once per run, all at the same time (a
 // job that waits for all the others would hang otherwise), job 0 on the calling thread and job j on
 // the same thread from run to run, and a larger run after a smaller one grows the team; whether the
