@@ -103,14 +103,18 @@ CLI::Validator non_empty() {
 
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
                                              const AccelOptions& options) {
-    // A tree's single-ray kernel named with SIMD packets, which would replace it (the library refuses
-    // it too): said in the options' words, once the SIMD set is known to be one.
-    if (names_replaced_traversal(config)) {
+    // A SIMD set this binary or processor cannot run, named by the option that gave it.
+    const auto check_simd = [&] {
         try {
             detail::parse_isa(config.simd);
         } catch (const Error& e) {
             throw Error(options.simd_source() + ": " + e.what());
         }
+    };
+    // A tree's single-ray kernel named with SIMD packets, which would replace it (the library refuses
+    // it too): said in the options' words, once the SIMD set is known to be one.
+    if (names_replaced_traversal(config)) {
+        check_simd();
         const std::string kernel =
             options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'";
         if (kernel == options.simd_source())
@@ -124,11 +128,7 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
         accel = make_accelerator(triangles, config);
     } catch (const Error&) {
         if (config.simd == "off") throw;
-        try {
-            detail::parse_isa(config.simd);
-        } catch (const Error& e) {
-            throw Error(options.simd_source() + ": " + e.what());
-        }
+        check_simd();
         throw;
     }
     return accel;

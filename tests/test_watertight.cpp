@@ -11,6 +11,7 @@
 #include "cellrt/brute_force.hpp"
 #include "cellrt/triangle.hpp"
 #include "scene/mesh_builder.hpp"
+#include "slivers.hpp"
 #include "triangle_distance.hpp"
 
 namespace cellrt {
@@ -18,6 +19,8 @@ namespace {
 
 using test::relative_miss;
 using test::relative_uv_gap;
+using test::random_sliver;
+using test::ray_onto;
 
 Hit closest(std::span<const Triangle> tris, const Ray& ray) {
     const auto brute = make_brute_force(tris, AccelConfig{"brute"});
@@ -230,18 +233,9 @@ TEST(Watertight, IllConditionedHitsLieOnTheirTriangle) {
     std::uniform_real_distribution<float> u01(0.f, 1.f);
     std::size_t hits = 0, grazing = 0;
     for (int i = 0; i < 400; ++i) {
-        const Vec3 a{u01(rng) * 4, u01(rng) * 4, u01(rng) * 4};
-        const Vec3 b = a + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * 12.f;
-        const float width = i % 2 ? 2e-6f : 1e-3f;
-        const Vec3 c = a + (b - a) * u01(rng) + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * width;
-        const Triangle tri{a, b, c};
-        const Vec3 normal = normalize(tri.geometric_normal());
+        const Triangle tri = random_sliver(rng, 12.f, [&] { return i % 2 ? 2e-6f : 1e-3f; });
         for (int k = 0; k < 50; ++k) {
-            const float w0 = u01(rng), w1 = u01(rng) * (1.f - w0);
-            const Vec3 target = a * w0 + b * w1 + c * (1.f - w0 - w1);
-            Vec3 from = target + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * 16.f;
-            if (k % 2) from = from - normal * (dot(from - target, normal) * (1.f - 1e-6f * u01(rng)));  // grazing
-            const Ray ray{from, 0.f, target - from, kInfinity};
+            const Ray ray = ray_onto(tri, rng, k % 2, [&] { return 1e-6f * u01(rng); });  // odd rays graze
             float t, bu, bv;
             if (!intersect_unbounded(WatertightRay(ray), tri, t, bu, bv)) continue;
             ++hits;

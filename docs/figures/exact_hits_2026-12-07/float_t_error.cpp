@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <random>
 #include "cellrt/triangle.hpp"
+#include "slivers.hpp"
 #include "triangle_distance.hpp"
 using namespace cellrt;
 using namespace cellrt::test;
@@ -17,19 +18,10 @@ int main() {
     std::uniform_real_distribution<float> u01(0.f, 1.f);
     double worst[8] = {0}; int count[8] = {0};
     for (int i = 0; i < 4000; ++i) {
-        const Vec3 a{u01(rng) * 4, u01(rng) * 4, u01(rng) * 4};
         const float len = i % 3 == 0 ? 12.f : (i % 3 == 1 ? 1.f : 0.1f);
-        const Vec3 b = a + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * len;
-        const float width = std::pow(10.f, -1.f - 6.f * u01(rng)) * len;
-        const Vec3 c = a + (b - a) * u01(rng) + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * width;
-        const Triangle tri{a, b, c};
-        const Vec3 normal = normalize(tri.geometric_normal());
+        const Triangle tri = random_sliver(rng, len, [&] { return std::pow(10.f, -1.f - 6.f * u01(rng)) * len; });
         for (int k = 0; k < 50; ++k) {
-            const float w0 = u01(rng), w1 = u01(rng) * (1.f - w0);
-            const Vec3 target = a * w0 + b * w1 + c * (1.f - w0 - w1);
-            Vec3 from = target + Vec3{u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f} * 16.f;
-            if (k % 2) from = from - normal * (dot(from - target, normal) * (1.f - std::pow(10.f, -1.f - 6.f * u01(rng))));
-            const Ray ray{from, 0.f, target - from, kInfinity};
+            const Ray ray = ray_onto(tri, rng, k % 2, [&] { return std::pow(10.f, -1.f - 6.f * u01(rng)); });
             WatertightRay w(ray);
             const float* c9 = reinterpret_cast<const float*>(&tri);
             float X[3],Y[3],Z[3];
