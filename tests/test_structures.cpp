@@ -169,12 +169,16 @@ INSTANTIATE_TEST_SUITE_P(Structures, SubnormalDirectionComponents, testing::Valu
 // from the origins to the scene overflow a float (up to 8.8 * 2^128) while the triangles' edge
 // functions do not: the direct margin was inf / inf, NaN, and every structure culled the whole
 // scene (fuzz_gltf found a glTF scene at 8.4e18); traversal_margin's second branch. At 2^-52 the
-// squares are near 2^-104, still normal: every value small, nothing else.
+// squares are near 2^-104, still normal: every value small, nothing else. At 2^-46 with the
+// directions unscaled, t scales by 2^-46 and the test's T, a length cubed, is subnormal (the edge
+// functions stay normal); such hits are taken again in double precision (triangle.hpp,
+// ill_conditioned), so brute force finds the unscaled triangles at t within rounding of the scaled.
 class ScaledByPowersOfTwo : public testing::TestWithParam<std::string> {};
 
 TEST_P(ScaledByPowersOfTwo, SameHits) {
     struct Case {
         int exponent;
+        bool directions;  // scaled too (t unchanged), or left alone (t scaled)
         std::vector<Triangle> tris;
         test::ReferenceAnswers ref;
     };
@@ -183,24 +187,36 @@ TEST_P(ScaledByPowersOfTwo, SameHits) {
         test::ReferenceAnswers unscaled =
             test::compute_reference(tris, test::RaySuite(tris, test::small_suite()).rays());
         std::vector<Case> out;
-        for (const int e : {64, -52}) {
+        for (const auto& [e, directions] : {std::pair{64, true}, std::pair{-52, true}, std::pair{-46, false}}) {
             const float s = std::ldexp(1.f, e);
             std::vector<Ray> rays = unscaled.rays;
-            for (Ray& r : rays)
-                if (is_valid(r)) r.org = r.org * s, r.dir = r.dir * s;
+            for (Ray& r : rays) {
+                if (!is_valid(r)) continue;
+                r.org = r.org * s;
+                if (directions) r.dir = r.dir * s;
+                else r.tnear *= s, r.tfar *= s;
+            }
             std::vector<Triangle> scaled = test::soup(s);
             test::ReferenceAnswers ref = test::compute_reference(scaled, std::move(rays));
-            out.push_back({e, std::move(scaled), std::move(ref)});
+            out.push_back({e, directions, std::move(scaled), std::move(ref)});
         }
         return std::pair{std::move(unscaled), std::move(out)};
     }();
     for (const Case& c : cases) {
-        const std::string what = GetParam() + " on a soup scaled by 2^" + std::to_string(c.exponent);
+        const std::string what = GetParam() + " on a soup scaled by 2^" + std::to_string(c.exponent) +
+                                 (c.directions ? "" : ", directions unscaled");
         std::size_t differ = 0, hits = 0;
         for (std::size_t i = 0; i < base.hits.size(); ++i) {
-            differ += c.ref.hits[i].prim != base.hits[i].prim || !(c.ref.hits[i].t == base.hits[i].t);
-
-            hits += base.hits[i].is_hit();
+            const Hit& got = c.ref.hits[i];
+            const Hit& want = base.hits[i];
+            if (c.directions) {
+                differ += got.prim != want.prim || !(got.t == want.t);
+            } else {  // t within rounding of the scaled t: double precision where T underflowed
+                const float scaled_t = std::ldexp(want.t, c.exponent);
+                differ += got.prim != want.prim ||
+                          (want.is_hit() && !(std::fabs(got.t - scaled_t) <= 1e-5f * std::fabs(scaled_t)));
+            }
+            hits += want.is_hit();
         }
         ASSERT_GT(hits, base.hits.size() / 10) << "the suite must meet the scene";
         EXPECT_LE(differ, base.hits.size() / 1000) << "brute force, " << what << ", against the unscaled soup";
@@ -210,6 +226,38 @@ TEST_P(ScaledByPowersOfTwo, SameHits) {
 
 INSTANTIATE_TEST_SUITE_P(Structures, ScaledByPowersOfTwo, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
+
+// A triangle some 1e-16 across, 1e-16 behind origins that look away from it along unit directions,
+// and a large one in front. The test's T, a length cubed, underflowed to zero and lost its sign: the
+// tiny triangle was hit at t = -0, which tnear = 0 admits, on every path and Embree's too (found by
+// audit, 2026-12-07). Rays looking the other way meet it in front, at t > 0.
+TEST(Structures, ATinyTriangleJustBehindTheOriginIsNotHit) {
+    for (const float s : {1e-16f, 1e-17f, 1e-18f}) {
+        const std::vector<Triangle> tris = {{{-s, -s, -s}, {3 * s, -s, -s}, {-s, 3 * s, -s}},
+                                            {{-5.f, -5.f, 1.f}, {5.f, -5.f, 1.f}, {0.f, 5.f, 1.f}}};
+        std::vector<Ray> rays;
+        for (int i = 0; i < 64; ++i) {
+            Ray r;
+            r.org = {s * 0.1f * float(i % 8), s * 0.1f * float(i / 8), 0.f};
+            r.dir = {0.3f, 0.1f, i % 2 ? 1.f : -1.f};
+            if (i % 4 == 1) r.tfar = 0.5f;  // looking up, short of the large triangle: not occluded
+            rays.push_back(r);
+        }
+        const test::ReferenceAnswers ref = test::compute_reference(tris, std::move(rays));
+        for (std::size_t i = 0; i < ref.rays.size(); ++i) {
+            if (i % 2 == 0) {  // looking down: the tiny triangle, in front
+                EXPECT_EQ(ref.hits[i].prim, 0u) << s << " ray " << i;
+                EXPECT_GT(ref.hits[i].t, 0.f) << s << " ray " << i;
+            } else {
+                EXPECT_EQ(ref.hits[i].prim, i % 4 == 1 ? kNoHit : 1u) << s << " ray " << i;
+                EXPECT_EQ(ref.occluded[i], i % 4 == 1 ? 0 : 1) << s << " ray " << i;
+            }
+        }
+        for (const std::string& config : kConfigs)
+            test::expect_matches(*make_accelerator(tris, parse_accel_config(config)), ref,
+                                 config + " at a scale of " + std::to_string(s));
+    }
+}
 
 // The packet kernels on the rays they are made for: a frame's primary rays in square tiles and the
 // shadow rays of their hits, in batches of 8 x 8 and 16 x 16 (entry-point search) and of sizes that

@@ -116,6 +116,19 @@ CELLRT_HD inline bool ill_conditioned(float lateral, float depth, float det) {
     return (lateral * depth) * (1.f / kIllConditioned) > std::fabs(det);
 }
 
+// Whether T (big_t, t times det), the sum of the three terms e_k z_k, lost its value to underflow:
+// T grows as the cube of the scene's size over the direction's, and on triangles some 1e-16 across
+// and away along a unit direction every term is subnormal or zero. T of zero had lost its sign: a
+// triangle just behind the origin was hit at t = -0, which tnear = 0 admits, on every path, before
+// the triangle really in front (found by audit, 2026-12-07). Such a hit's t is taken again in double
+// precision, which has the range. Terms of normal size that cancel to zero are left alone: that is
+// a ray starting on the triangle (t = 0 exactly, as brute force has it), where double precision
+// would give rounding noise of either sign. The terms are read only where T is tiny.
+CELLRT_HD inline bool t_underflowed(float big_t, float t0, float t1, float t2) {
+    return std::fabs(big_t) < kLeastNormal &&
+           std::max(std::max(std::fabs(t0), std::fabs(t1)), std::fabs(t2)) < kLeastNormal;
+}
+
 // t of an ill-conditioned hit, in double precision: the depth of the triangle's point nearest the
 // ray in the test's sheared frame (the ray the +z axis, t = depth * sz). Where the ray crosses the
 // triangle that is the crossing; where the float test found it inside by rounding only (a grazing
@@ -199,7 +212,8 @@ CELLRT_HD inline bool ill_conditioned(float lateral, float depth, float det) {
     const float det = eu + ev + ew;
     if (!det_in_range(det)) return false;
     const float az = r.sz * a_kz, bz = r.sz * b_kz, cz = r.sz * c_kz;
-    const float big_t = eu * az + ev * bz + ew * cz;
+    const float t0 = eu * az, t1 = ev * bz, t2 = ew * cz;
+    const float big_t = t0 + t1 + t2;
     const float inv_det = 1.f / det;
     t = big_t * inv_det;
     u = ev * inv_det;
@@ -208,7 +222,7 @@ CELLRT_HD inline bool ill_conditioned(float lateral, float depth, float det) {
     const float lateral = std::max(std::max(std::max(std::fabs(ax), std::fabs(bx)), std::fabs(cx)),
                                    std::max(std::max(std::fabs(ay), std::fabs(by)), std::fabs(cy)));
     const float depth = std::max(std::max(a_kz, b_kz), c_kz) - std::min(std::min(a_kz, b_kz), c_kz);
-    if (!ill_conditioned(lateral, depth, det)) [[likely]] return true;
+    if (!ill_conditioned(lateral, depth, det) && !t_underflowed(big_t, t0, t1, t2)) [[likely]] return true;
     const float xs[3] = {c9[r.kx], c9[3 + r.kx], c9[6 + r.kx]};
     const float ys[3] = {c9[r.ky], c9[3 + r.ky], c9[6 + r.ky]};
     const float zs[3] = {c9[r.kz], c9[3 + r.kz], c9[6 + r.kz]};
@@ -261,7 +275,9 @@ CELLRT_HD inline bool ill_conditioned(float lateral, float depth, float det) {
                                    _mm_cvtss_f32(_mm_movehl_ps(xy, xy)));
     const float a_kz = _mm_cvtss_f32(dz), b_kz = _mm_cvtss_f32(_mm_shuffle_ps(dz, dz, 1)), c_kz = _mm_cvtss_f32(_mm_movehl_ps(dz, dz));
     const float depth = std::max(std::max(a_kz, b_kz), c_kz) - std::min(std::min(a_kz, b_kz), c_kz);
-    if (ill_conditioned(lateral, depth, det)) [[unlikely]] return intersect_unbounded_rare(r, tri, t, u, v);
+    if (ill_conditioned(lateral, depth, det) ||
+        t_underflowed(big_t, _mm_cvtss_f32(p), _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1)), _mm_cvtss_f32(_mm_movehl_ps(p, p))))
+        [[unlikely]] return intersect_unbounded_rare(r, tri, t, u, v);
     return true;
 }
 #endif

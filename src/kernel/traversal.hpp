@@ -38,7 +38,8 @@ CELLRT_HD inline float max_keep(float kept, float x) { return x > kept ? x : kep
 // det at least 2^-126 (det_in_range), to about 2^-21.5; this keeps four times that. It only acts
 // where the whole scene lies within t < 2^-4 of the origin: for ordinary scenes and directions
 // the relative margin is larger (a 1e-17 scene along unit directions had garbage t of 0 that
-// brute force ranked first and the structures culled).
+// brute force ranked first and the structures culled). Such hits now take t in double precision
+// (triangle.hpp, ill_conditioned); the floor still covers that t's rounding to float.
 inline constexpr float kMarginFloor = 0x1p-20f;
 
 // The margin in t: kMarginScale times the largest distance from the origin to the scene box

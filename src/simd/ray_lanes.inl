@@ -74,7 +74,8 @@ template <class Coord>
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
     const F az = sz * a_kz, bz = sz * b_kz, cz = sz * c_kz;
-    const F big_t = eu * az + ev * bz + ew * cz;
+    const F t0 = eu * az, t1 = ev * bz, t2 = ew * cz;
+    const F big_t = t0 + t1 + t2;
     const F inv_det = splat(1.f) / det;
     t = big_t * inv_det;
     u = ev * inv_det;
@@ -87,8 +88,13 @@ template <class Coord>
         const F lateral = lane_max_f(lane_max_f(lane_max_f(abs_lanes(ax), abs_lanes(bx)), abs_lanes(cx)),
                                      lane_max_f(lane_max_f(abs_lanes(ay), abs_lanes(by)), abs_lanes(cy)));
         const F depth = lane_max_f(lane_max_f(a_kz, b_kz), c_kz) - lane_min_f(lane_min_f(a_kz, b_kz), c_kz);
-        const I ill = hit & (abs_lanes(t) < splat(kInfinity)) &
-                      ((lateral * depth) * splat(1.f / kIllConditioned) > abs_lanes(det));
+        I ill = hit & (abs_lanes(t) < splat(kInfinity)) &
+                ((lateral * depth) * splat(1.f / kIllConditioned) > abs_lanes(det));
+        // T lost to underflow (triangle.hpp, t_underflowed): its terms read only where T is tiny.
+        const F least = splat(kLeastNormal);
+        if (const I tiny = hit & (abs_lanes(big_t) < least); any(tiny)) [[unlikely]]
+            ill |= tiny & (abs_lanes(t) < splat(kInfinity)) &
+                   (lane_max_f(lane_max_f(abs_lanes(t0), abs_lanes(t1)), abs_lanes(t2)) < least);
         if (const unsigned lanes = bits(ill)) [[unlikely]]
             refine_lanes(coord, lanes, ox, oy, oz, sx, sy, sz, t, u, v, hit);
     }
