@@ -309,6 +309,13 @@ TEST(Render, ImagesAreZeroWhenMade) {
     EXPECT_TRUE(same_bits(copy, frame));
     EXPECT_EQ(copy.at(1919, 1079).y, 0.5f);
     EXPECT_EQ(copy.at(1918, 1079).y, 0.f);
+    // A negative side is refused, not read as a size of 2^64 pixels.
+    EXPECT_EQ(test::error_of([] { Image(-1, 5); }), "Image: image size -1x5: a side is negative");
+    EXPECT_EQ(test::error_of([] { Srgb8Image(5, -1); }), "Srgb8Image: image size 5x-1: a side is negative");
+    EXPECT_TRUE(Image(0, 3).pixels.empty());
+    Image wrong(2, 2);
+    wrong.width = 1;  // fields set by hand: four pixels named 1x2
+    EXPECT_EQ(test::error_of([&] { to_srgb8(wrong); }), "to_srgb8: an image of 4 pixels is not 1x2");
 }
 
 // ... and its memory untouched until written: a frame's pages are faulted in by the workers that

@@ -189,6 +189,9 @@ TEST(Schedule, RejectsBadSettings) {
     EXPECT_EQ(parse_dispatch("mailbox"), Dispatch::mailbox);
     std::vector<std::uint32_t> order(15);
     EXPECT_THROW(packet_order(PixelRect{0, 0, 4, 4}, order), Error);
+    // A packet past the grid's last would be a rect below the image.
+    EXPECT_EQ(PacketGrid(10, 10, 4).rect(8).y1, 10);
+    EXPECT_EQ(error_of([] { PacketGrid(10, 10, 4).rect(9); }), "PacketGrid::rect: packet 9 of a grid of 9");
     // A worker count is refused before a thread or buffer is made for it.
     ScheduleOptions many;
     many.workers = kMaxWorkers + 1;

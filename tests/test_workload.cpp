@@ -18,6 +18,7 @@
 #include "cellrt/render.hpp"
 #include "cellrt/sampling.hpp"
 #include "cellrt/workload.hpp"
+#include "error_of.hpp"
 
 namespace cellrt {
 namespace {
@@ -230,6 +231,23 @@ TEST(Workload, RefusesAnUnknownShadingAndAoSamplesOutOfRange) {
     const PinholeCamera camera(scene.camera, 8, 8);
     for (int n : {0, -1, kMaxAoSamples + 1})
         EXPECT_THROW(PacketWorkload(scene, camera, 64, shading_of(Shading::ao, n)), Error) << n;
+}
+
+// A packet outside the frame, empty, or larger than the buffers were made for is refused before a
+// ray is made (it would trace pixels that do not exist, or allocate in the middle of a frame).
+TEST(Workload, RefusesAPacketOutsideTheFrameOrLargerThanItsBuffers) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=200");
+    const PinholeCamera camera(scene.camera, 8, 8);
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"bvh"});
+    PacketWorkload work(scene, camera, 16);
+    work.trace(PixelRect{4, 4, 8, 8}, *accel);
+    EXPECT_EQ(work.batch(RayKind::primary).rays.size(), 16u);
+    for (const PixelRect& bad : {PixelRect{6, 6, 10, 10}, PixelRect{-1, 0, 3, 4}, PixelRect{2, 2, 2, 6},
+                                 PixelRect{0, 0, 5, 4}})
+        EXPECT_THROW(work.trace(bad, *accel), Error) << bad.x0 << " " << bad.y0 << " " << bad.x1 << " " << bad.y1;
+    EXPECT_EQ(test::error_of([&] { work.trace(PixelRect{0, 0, 8, 9}, *accel); }),
+              "PacketWorkload::trace: packet [0, 8) x [0, 9) is empty, outside the 8x8 frame or larger than the "
+              "workload's 16 pixels");
 }
 
 // The frame of the hemisphere: unit directions that never point below the surface, for normals along

@@ -17,7 +17,7 @@ struct Image {
     ZeroedArray<Vec3> pixels;  // row-major, row 0 at the top, linear radiance; zero until written
 
     Image() = default;
-    Image(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h) {}
+    Image(int w, int h);  // throws cellrt::Error for a negative side
     Vec3& at(int x, int y) { return pixels[static_cast<std::size_t>(y) * width + x]; }
     const Vec3& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
@@ -37,7 +37,7 @@ struct Srgb8Image {
     ZeroedArray<std::uint8_t> rgb;
 
     Srgb8Image() = default;
-    Srgb8Image(int w, int h) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3) {}
+    Srgb8Image(int w, int h);  // throws cellrt::Error for a negative side
 };
 
 // One linear channel's byte in a PNG: linear_to_srgb, scaled to [0, 255] and rounded (std::lround);
@@ -45,7 +45,8 @@ struct Srgb8Image {
 std::uint8_t srgb8(float linear);
 std::uint8_t srgb8_exact(float linear);
 
-// The 8-bit sRGB pixels write_image puts in a PNG of `image`.
+// The 8-bit sRGB pixels write_image puts in a PNG of `image`. Throws cellrt::Error where its pixels
+// are not width x height.
 Srgb8Image to_srgb8(const Image& image);
 
 // Writes a PNG of 8-bit pixels, as write_image does (atomically; `overwrite` as there): for the pixels

@@ -42,7 +42,7 @@ inline constexpr int kMaxPacket = 256;
 
 // The image in packets of `packet` x `packet` pixels (1 <= packet <= kMaxPacket), row-major; packets
 // at the right and bottom edges are cut to the image (partial packets are traced, never dropped).
-// Throws cellrt::Error for a size or a packet edge out of range.
+// Throws cellrt::Error for a side below 1 or a packet edge out of range.
 struct PacketGrid {
     int width, height, packet;
 
@@ -50,7 +50,7 @@ struct PacketGrid {
     int columns() const { return (width + packet - 1) / packet; }
     int rows() const { return (height + packet - 1) / packet; }
     std::size_t count() const { return static_cast<std::size_t>(columns()) * rows(); }
-    PixelRect rect(std::size_t index) const;
+    PixelRect rect(std::size_t index) const;  // throws cellrt::Error unless index < count()
 };
 
 // The pixels of a packet in the order its rays are traced: Morton (Z) order, so that any 4, 8 or 16

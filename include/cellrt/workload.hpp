@@ -78,6 +78,8 @@ public:
     // Traces the packet `rect` through `accel`: its primary rays, then the rays its shading casts
     // (their random numbers seeded by the pixel's index y * width + x in the camera's frame). The
     // counters of the primary batch are added to `primary`, those of every other to `secondary`.
+    // Throws cellrt::Error for a rect that is empty, reaches outside the camera's frame or has more
+    // than `max_pixels` pixels.
     void trace(const PixelRect& rect, const Accelerator& accel, TraversalCounters* primary = nullptr,
                TraversalCounters* secondary = nullptr);
 

@@ -37,7 +37,19 @@ std::string encode_pfm(const Image& image) {
     return std::move(out).str();
 }
 
+// The pixel count of a w x h image; a negative side is a caller's mistake that would otherwise
+// become a request for 2^64 pixels.
+std::size_t pixel_count(const char* what, int w, int h) {
+    if (w < 0 || h < 0)
+        throw Error(std::string(what) + ": image size " + std::to_string(w) + "x" + std::to_string(h) + ": a side is negative");
+    return static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+}
+
 }  // namespace
+
+Image::Image(int w, int h) : width(w), height(h), pixels(pixel_count("Image", w, h)) {}
+
+Srgb8Image::Srgb8Image(int w, int h) : width(w), height(h), rgb(pixel_count("Srgb8Image", w, h) * 3) {}
 
 float linear_to_srgb(float linear) {
     const float c = linear > 0.f ? std::fmin(linear, 1.f) : 0.f;  // NaN as 0, as the docs say
@@ -108,6 +120,11 @@ std::uint8_t srgb8(float linear) { return srgb8_table()(linear); }
 Srgb8Image to_srgb8(const Image& image) {
     const Srgb8Table& table = srgb8_table();
     Srgb8Image out(image.width, image.height);
+    // Fields set by hand could hold more pixels than width x height: written past `out` (found by
+    // review, 2026-12-07).
+    if (image.pixels.size() != out.rgb.size() / 3)
+        throw Error("to_srgb8: an image of " + std::to_string(image.pixels.size()) + " pixels is not " +
+                    std::to_string(image.width) + "x" + std::to_string(image.height));
     for (std::size_t i = 0; i < image.pixels.size(); ++i)
         for (int c = 0; c < 3; ++c) out.rgb[3 * i + c] = table(image.pixels[i][c]);
     return out;

@@ -103,6 +103,7 @@ struct RayBuffers {
 struct alignas(kCacheLine) PacketWorkload::Buffers {
     CacheLineVector<std::uint32_t> order;
     int order_width = 0, order_height = 0;  // the packet shape `order` was made for
+    std::size_t max_pixels = 0;             // the largest packet the buffers were reserved for
     CacheLineVector<std::uint64_t> pixel;   // primary ray i's pixel index in the frame
     std::array<RayBuffers, kRayKinds> kinds;
 
@@ -118,6 +119,7 @@ PacketWorkload::PacketWorkload(const Scene& scene, const FrameShading& frame, st
     : scene_(&scene), frame_(frame), buffers_(std::make_unique<Buffers>()) {
     check_ao_samples(frame.shading.ao_samples);  // a FrameShading made by hand
     Buffers& b = *buffers_;
+    b.max_pixels = max_pixels;
     b.order.reserve(max_pixels);
     b.pixel.reserve(max_pixels);
     b[RayKind::primary].reserve(max_pixels);
@@ -139,6 +141,15 @@ PacketWorkload::~PacketWorkload() = default;
 void PacketWorkload::trace(const PixelRect& rect, const Accelerator& accel, TraversalCounters* primary,
                            TraversalCounters* secondary) {
     Buffers& b = *buffers_;
+    // A rect outside the frame would trace rays of pixels that do not exist (and seed them as pixels
+    // of the next row); one larger than the buffers would allocate in the middle of a frame.
+    const int width = static_cast<int>(frame_.camera.width), height = static_cast<int>(frame_.camera.height);
+    if (rect.x0 < 0 || rect.y0 < 0 || rect.x1 > width || rect.y1 > height || rect.x0 >= rect.x1 ||
+        rect.y0 >= rect.y1 || static_cast<std::size_t>(rect.pixels()) > b.max_pixels)
+        throw Error("PacketWorkload::trace: packet [" + std::to_string(rect.x0) + ", " + std::to_string(rect.x1) + ") x [" +
+                    std::to_string(rect.y0) + ", " + std::to_string(rect.y1) + ") is empty, outside the " +
+                    std::to_string(width) + "x" + std::to_string(height) +
+                    " frame or larger than the workload's " + std::to_string(b.max_pixels) + " pixels");
     if (rect.width() != b.order_width || rect.height() != b.order_height) {  // only edge packets differ
         b.order.resize(static_cast<std::size_t>(rect.pixels()));
         packet_order(rect, b.order);

@@ -274,6 +274,8 @@ PacketGrid::PacketGrid(int w, int h, int p) : width(w), height(h), packet(p) {
 }
 
 PixelRect PacketGrid::rect(std::size_t index) const {
+    if (index >= count())
+        throw Error("PacketGrid::rect: packet " + std::to_string(index) + " of a grid of " + std::to_string(count()));
     const int cx = static_cast<int>(index % static_cast<std::size_t>(columns()));
     const int cy = static_cast<int>(index / static_cast<std::size_t>(columns()));
     const int x0 = cx * packet, y0 = cy * packet;
