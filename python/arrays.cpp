@@ -39,6 +39,9 @@ std::string dtype_of(const py::array& a) { return py::str(a.dtype()).cast<std::s
 
 void check_real(const py::array& a, const std::string& name) {
     const char kind = a.dtype().kind();
+    if (kind == 'O')  // numpy's answer to a Python integer past 64 bits, or to values of mixed types
+        throw py::value_error(name + " must hold real numbers, got Python objects (an integer past 64 bits, or a "
+                                     "value numpy holds as no number); pass floats");
     if (kind != 'f' && kind != 'i' && kind != 'u')
         throw py::value_error(name + " must hold real numbers, got dtype " + dtype_of(a));
 }
@@ -276,7 +279,8 @@ Vec3 vec3_value(py::handle object, const std::string& name) {
     const py::array a = as_array(object, name);
     if (a.ndim() != 1 || a.shape(0) != 3) throw py::value_error(name + " must have shape (3,), got " + shape_of(a));
     check_real(a, name);
-    const float* p = static_cast<const float*>(required(a, "float32", name).data());
+    const py::array f = required(a, "float32", name);  // held: a converted copy lives as long as it
+    const float* p = static_cast<const float*>(f.data());
     if (!finite3(p)) throw py::value_error(name + " = " + vec_text(p) + " is not finite");
     return Vec3{p[0], p[1], p[2]};
 }

@@ -113,6 +113,10 @@ namespace {
 // for_valid_chunks for an accelerator that may refuse rays (Embree's domain): a chunk holding one is
 // not traced, and once every chunk is done the lowest such chunk is checked again, so that the error
 // names the call's first refused ray by its index in the call, whichever thread met which chunk first.
+// A chunk with an invalid ray is neither traced nor checked: the rays before the first invalid one
+// in its chunk are checked here, so that the earlier of the first invalid ray and the first refused
+// one is the one named (found by audit, 2026-12-07: Embree's refusal of ray 3000 was raised over an
+// invalid ray 100). Chunks start at multiples of kChunk (Team::for_chunks).
 template <class Trace>
 std::size_t for_admitted_chunks(const Accelerator& accel, const Team& team, const RayInput& in, Trace&& trace) {
     if (!accel.refuses_rays()) return for_valid_chunks(team, in, trace);
@@ -126,11 +130,14 @@ std::size_t for_admitted_chunks(const Accelerator& accel, const Team& team, cons
         }
         trace(rays, begin);
     });
-    if (const std::size_t begin = refused.load(); begin != kAllValid) {
-        std::vector<Ray> rays(std::min(in.count - begin, kChunk));
-        assemble(in, begin, begin + rays.size(), rays.data());
-        accel.check_rays(rays, begin);  // throws, naming the ray
-    }
+    const auto check = [&](std::size_t begin, std::size_t end) {  // throws, naming the ray
+        std::vector<Ray> rays(end - begin);
+        assemble(in, begin, end, rays.data());
+        accel.check_rays(rays, begin);
+    };
+    if (const std::size_t begin = refused.load(); begin != kAllValid && begin < first_invalid)
+        check(begin, std::min(in.count, begin + kChunk));
+    if (first_invalid != kAllValid) check(first_invalid - first_invalid % kChunk, first_invalid);
     return first_invalid;
 }
 

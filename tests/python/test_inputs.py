@@ -146,6 +146,8 @@ def test_numpy_integers_are_accepted_as_counts():
     ((O, D), {"tfar": np.zeros((4, 1))}, r"tfar must be a scalar or have shape \(N,\), got \(4, 1\)"),
     ((O, D), {"tfar": "far"}, "tfar must hold real numbers"),
     ((O, D), {"tnear": None}, "tnear must hold real numbers"),
+    ((O, D), {"tfar": 2**70}, "tfar must hold real numbers, got Python objects"),
+    ((O, D), {"tnear": [0, 2**64, 0, 0]}, "tnear must hold real numbers, got Python objects"),
 ])
 def test_bad_rays(acc, method, args, kwargs, match):
     refused(match, getattr(acc, method), *args, **kwargs)
@@ -166,6 +168,14 @@ def test_a_ray_embree_refuses_is_named_by_its_index_in_the_call():
         embree.intersect(np.tile(O, (1000, 1)), np.tile(D, (1000, 1)), tnear=tnear)
     with pytest.raises(cellrt.Error, match="ray 2500 of the batch"):
         embree.occluded(np.tile(O, (1000, 1)), np.tile(D, (1000, 1)), tnear=tnear)
+    # An invalid ray before it is the first bad ray, whichever chunk a thread met first.
+    o = np.tile(O, (1000, 1))
+    o[100, 0] = np.nan
+    for method in (embree.intersect, embree.occluded):
+        refused(r"origins\[100\] is not finite", method, o, np.tile(D, (1000, 1)), tnear=tnear)
+    o[100, 0], o[3000, 0] = 0, np.nan
+    with pytest.raises(cellrt.Error, match="ray 2500 of the batch"):
+        embree.intersect(o, np.tile(D, (1000, 1)), tnear=tnear)
 
 
 def test_infinite_bounds_and_degenerate_rays_are_valid(acc):
