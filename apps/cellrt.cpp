@@ -4,12 +4,25 @@
 #include <cstdio>
 #include <exception>
 
+#include <unistd.h>
+
 #include "cellrt/error.hpp"
 #include "cli.hpp"
 #include "cluster.hpp"
 
 namespace {
-extern "C" void on_interrupt(int) { cellrt::cli::g_cancel.store(true); }
+// Whether an interrupt outside a frame says so: not under MPI, where mpirun ends the other ranks so
+// when one fails (its error is the one line to read) and forwards a Ctrl-C to every rank.
+bool g_say_interrupted = true;
+
+// Only async-signal-safe calls: the atomics are lock-free, write and _exit are the system's.
+extern "C" void on_interrupt(int) {
+    cellrt::cli::g_cancel.store(true);
+    if (cellrt::cli::g_cancellable.load()) return;
+    static const char message[] = "cellrt: error: interrupted\n";
+    if (g_say_interrupted) [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, message, sizeof message - 1);
+    _exit(130);
+}
 
 int run(int argc, char** argv) {
     using namespace cellrt;
@@ -25,6 +38,7 @@ int run(int argc, char** argv) {
     std::size_t chosen = 0;
     for (std::size_t i = 0; i < subcommands.size(); ++i)
         if (*subcommands[i]) chosen = i;
+    g_say_interrupted = cli::cluster::ranks() == 1;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
     try {

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 namespace cellrt::cli {
 
 std::atomic<bool> g_cancel{false};
+std::atomic<bool> g_cancellable{false};
 
 std::string scene_help() {
     std::string names;
@@ -23,17 +25,22 @@ std::string scene_help() {
 }
 
 void AccelOptions::add_to(CLI::App& cmd, bool kind_optional, bool with_device) {
-    std::string kinds;
-    for (const auto& k : accelerator_kinds()) kinds += (kinds.empty() ? "" : "|") + k;
+    std::string kinds, traversals;  // every kind's traversals, from the library (the default first)
+    for (const auto& k : accelerator_kinds()) {
+        kinds += (kinds.empty() ? "" : "|") + k;
+        std::string own;
+        for (const std::string& t : accelerator_traversals(k)) own += (own.empty() ? "" : "|") + t;
+        traversals += (traversals.empty() ? "" : ", ") + k + ": " + own;
+    }
     if (kind_optional) kind.clear();
     cmd.add_option("--accel", kind,
                    "Acceleration structure: " + kinds +
                        ", or a whole configuration KIND[:TRAVERSAL][+SIMD][@NAME=VALUE,...] as the benchmarks, the C "
                        "API and Python name it (the options below add to it)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(non_empty());
     traversal_option = cmd.add_option("--traversal", traversal,
-                   "Traversal (kd: rec|branched|branchless, bih: branched|branchless, bvh: wide|paired|stream|packet); "
-                   "implies --simd off")
+                   "Traversal (" + traversals + "); implies --simd off")
                            ->check(non_empty());
     simd_option = cmd.add_option("--simd", simd,
                                  "SIMD ray packets: auto|off|portable|sse|avx2|avx512 (docs/PACKETS.md)")
@@ -132,6 +139,28 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
         throw;
     }
     return accel;
+}
+
+void check_structure(const AccelOptions& options) {
+    const AccelConfig config = options.config();
+    // The library's words for an unknown kind or traversal, behind the option that gave it.
+    const std::vector<std::string> kinds = accelerator_kinds();
+    if (std::find(kinds.begin(), kinds.end(), config.kind) == kinds.end()) {
+        try {
+            accelerator_traversals(config.kind);
+        } catch (const Error& e) {
+            throw Error("--accel '" + options.kind + "': " + e.what());
+        }
+    }
+    const std::vector<std::string>& traversals = accelerator_traversals(config.kind);
+    if (!config.traversal.empty() && std::find(traversals.begin(), traversals.end(), config.traversal) == traversals.end()) {
+        std::string offered;
+        for (const std::string& t : traversals) offered += (offered.empty() ? "" : ", ") + t;
+        throw Error((options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'") +
+                    ": " + config.kind + " has no traversal '" + config.traversal + "' (it has: " + offered + ")");
+    }
+    static const Triangle kOne{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+    build_structure(std::span<const Triangle>(&kOne, 1), config, options);
 }
 
 void check_threads(unsigned threads) {

@@ -27,8 +27,20 @@ Runner add_info(CLI::App& app);
 Runner add_profile(CLI::App& app);
 Runner add_cache_study(CLI::App& app);
 
-// Set by SIGINT/SIGTERM; renders stop at the next packet and leave no partial output.
+// Set by SIGINT/SIGTERM inside a Cancellable section (a frame, a cache study's runs, the writing of
+// results), which stops at the next packet or run, leaves no partial output, and ends with status
+// 130. Outside one (a load, a build, `info`, `profile`) the signal ends the program at once with
+// status 130 (cellrt.cpp's on_interrupt): those leave nothing behind, and polled nowhere they ran to
+// the end and exited 0 (found by audit, 2026-12-07: `timeout` could not stop a long build).
 extern std::atomic<bool> g_cancel;
+extern std::atomic<bool> g_cancellable;
+
+struct Cancellable {
+    Cancellable() { g_cancellable.store(true); }
+    ~Cancellable() { g_cancellable.store(false); }
+    Cancellable(const Cancellable&) = delete;
+    Cancellable& operator=(const Cancellable&) = delete;
+};
 
 // The scene argument's help text (view file, mesh or builtin:NAME).
 std::string scene_help();
@@ -63,6 +75,12 @@ struct AccelOptions {
 // SIMD packets) is refused.
 std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles, const AccelConfig& config,
                                              const AccelOptions& options);
+
+// The structure `options` name, built over one triangle and thrown away: an unknown kind, traversal,
+// parameter or SIMD set, or --device cuda without a GPU, is refused before a scene is loaded (found
+// by audit, 2026-12-07: `render --size 0x0` or `--accel bogus` loaded a 5M-triangle scene first, and
+// `info` printed half its report), in the words of the option that gave it.
+void check_structure(const AccelOptions& options);
 
 void print_stats(const AccelStats& s);
 

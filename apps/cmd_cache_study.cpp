@@ -390,10 +390,7 @@ Runner add_cache_study(CLI::App& app) {
                 std::error_code ec;
                 if (std::filesystem::is_directory(o->out, ec))
                     for (const std::string& p : {csv_path, md_path}) check_output_file(p, o->overwrite);
-                std::vector<std::pair<std::string, std::string>> inputs;
-                for (const std::string& spec : o->scenes)
-                    for (auto& file : scene_files(spec)) inputs.push_back(std::move(file));
-                check_distinct_files({{"--out", csv_path}, {"--out", md_path}}, inputs);
+                check_distinct_files({{"--out", csv_path}, {"--out", md_path}}, scene_files(o->scenes));
             }
         }, "checking the options");
         const unsigned threads = o->threads ? o->threads : cluster::cores();
@@ -456,7 +453,10 @@ Runner add_cache_study(CLI::App& app) {
                 std::fflush(stdout);
             }, "building the structures");
             Timer timer;
-            const std::vector<Result> results = gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
+            const std::vector<Result> results = [&] {
+                const Cancellable cancellable;
+                return gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
+            }();
             if (!cluster::leader()) continue;
             if (gpu)
                 std::printf("  %zu runs in %.1f s on %s\n", runs.size(), timer.seconds(), cuda_device_info().name.c_str());
@@ -478,6 +478,7 @@ Runner add_cache_study(CLI::App& app) {
             for (const std::string& key : group_order) md += best_layout_line(scene.name, runs, results, groups[key]);
         }
         if (!cluster::leader()) return 0;
+        const Cancellable cancellable;  // a signal while the results are written is seen after: both whole
         std::error_code ec;
         std::filesystem::create_directories(o->out, ec);
         if (!std::filesystem::is_directory(o->out, ec)) throw Error("--out '" + o->out + "': cannot create the folder");

@@ -79,6 +79,7 @@ Runner add_info(CLI::App& app) {
         }
         if (o->accel.kind.empty() && o->accel.describes_structure())
             throw Error("info: --traversal, --simd, -P and --threads describe a structure: give --accel too");
+        if (!o->accel.kind.empty()) check_structure(o->accel);
         Timer load_timer;
         const Scene scene = load_scene(o->scene);
         print_scene(scene, load_timer.seconds());

@@ -173,7 +173,6 @@ RenderOptions profiled_frame(const Scene& scene, const ProfileOptions& o, bool h
     if (!o.size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o.size);
     ro.threads = 1;
     ro.packet = o.packet;
-    ro.cancel = &g_cancel;
     return ro;
 }
 
@@ -279,6 +278,8 @@ int run_profile(const ProfileOptions& o) {
     if (o.packet < 1 || o.packet > kMaxPacket)
         throw Error("--packet " + std::to_string(o.packet) + " must lie in [1, " + std::to_string(kMaxPacket) + "]");
     p.config = profiled_config(o.accel, p.hardware);
+    if (!o.size.empty()) parse_image_size("--size", o.size);
+    check_structure(o.accel);
     const Scene scene = load_scene(o.scene);
     p.frame = profiled_frame(scene, o, p.hardware);
     const auto accel = build_structure(scene.triangles, p.config, o.accel);

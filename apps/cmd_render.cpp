@@ -205,6 +205,14 @@ Runner add_render(CLI::App& app) {
             local_store = o->local_store.config(o->packet);
             if (o->local_store.enabled && cluster::ranks() > 1)
                 throw Error("--local-store models one process's workers: run it with cellrt, not under mpirun");
+            // Every option that does not need the scene, before it is loaded.
+            if (!o->size.empty()) parse_image_size("--size", o->size);
+            try {
+                parse_dispatch(o->dispatch);
+            } catch (const Error& e) {
+                throw option_error("--dispatch", e);
+            }
+            if (!o->local_store.enabled) check_structure(o->accel);
             if (cluster::leader()) {
                 check_output_file(o->out, o->overwrite);
                 if (!o->stats.empty()) check_output_file(o->stats, o->overwrite);
@@ -252,6 +260,7 @@ Runner add_render(CLI::App& app) {
         // The frame's wall time from its memory to its last pixel: what cellrt-mpi's render seconds
         // span (its frame, window and renderers included), where the plain render's figure is the
         // tracing alone; the two programs compare on this one (docs/DISTRIBUTED.md).
+        const Cancellable cancellable;  // the frame, and the writing of its files
         Timer frame_timer;
         cluster::render(scene, accel, ro, lower_extension(o->out) == ".png", frame, rs, ranks_report);
         const double frame_s = frame_timer.seconds();

@@ -162,6 +162,13 @@ TEST(Builtin, BadSpecsAreNamed) {
     EXPECT_EQ(error_of("builtin:forest?seed=18446744073709551616"),
               "builtin:forest?seed=18446744073709551616: 'seed' must lie in [0, 18446744073709551615]");
     EXPECT_EQ(make_builtin_scene("builtin:spheres?tris=100&seed=18446744073709551615").name, "spheres");
+    // Stray separators, as "&&" already was (found by audit, 2026-12-07: these were accepted).
+    EXPECT_EQ(error_of("builtin:city?"), "builtin:city?: expected key=value, got ''");
+    EXPECT_EQ(error_of("builtin:city?tris=100&"), "builtin:city?tris=100&: expected key=value, got ''");
+    // check_builtin_spec says the same without making the scene.
+    EXPECT_THROW(check_builtin_spec("builtin:city?tris=100&"), Error);
+    EXPECT_THROW(check_builtin_spec("builtin:castle"), Error);
+    EXPECT_NO_THROW(check_builtin_spec("builtin:forest?tris=100000000"));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -80,6 +80,28 @@ TEST(Cli, InterruptedRenderLeavesNoFile) {
     }
 }
 
+// Outside a frame (a load, a build, `info`) nothing polls for the signal: SIGINT and SIGTERM end the
+// program at once with status 130 and a line saying so (found by audit, 2026-12-07: `info` ran a
+// long build to its end and exited 0, and `timeout` could not stop it).
+TEST(Cli, InterruptedBuildEndsAtOnce) {
+    for (const int signal : {SIGINT, SIGTERM}) {
+        TempDir dir;
+        const fs::path errors = dir.path / "errors.txt";
+        const pid_t pid = spawn({CELLRT_CLI, "info", "builtin:forest?tris=2000000", "--accel", "kd", "--threads", "1"},
+                                errors.string());
+        ASSERT_GT(pid, 0);
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        const auto sent = std::chrono::steady_clock::now();
+        kill(pid, signal);
+        EXPECT_EQ(wait_exit(pid), 130) << signal;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+        EXPECT_LT(seconds, 0.5) << signal;
+        std::ifstream in(errors);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_EQ(text, "cellrt: error: interrupted\n") << signal;
+    }
+}
+
 // Every path through the program gives the same bits, under every shading: structures, SIMD,
 // traversals, dispatch modes, worker counts and packet sizes (including packets that do not divide the
 // image).
@@ -292,11 +314,23 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "--accel", "bih:branched+auto"},
          "--accel 'bih:branched+auto' names a single-ray kernel ('branched') and SIMD packets ('auto'), which would "
          "replace it: leave one of them out"},
+        // Options that need no scene, refused before it is loaded, in the option's words (found by
+        // audit, 2026-12-07: a 5M-triangle city was made first, and `info` printed half its report).
+        {{"render", "builtin:city?tris=5000000", "--size", "0x0", "-o", out}, "--size '0x0' must have both sides in [1, 65536]"},
+        {{"info", "builtin:city?tris=5000000", "--accel", "kd", "--traversal", "bogus"},
+         "--traversal 'bogus': kd has no traversal 'bogus' (it has: branched, rec, branchless)"},
+        {{"render", "builtin:city?tris=5000000", "--accel", "bih:bogus", "-o", out},
+         "--accel 'bih:bogus': bih has no traversal 'bogus' (it has: branched, branchless)"},
+        {{"info", spheres, "--accel", ""}, "--accel: must not be empty (see --help)"},
         {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
         {{"info", dir.path.string()}, dir.path.string() + ": is a folder, not a file"},  // no extension
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},
         {{"render", spheres, "-o", out, "--stats", (dir.path / "no" / "s.json").string()},
          (dir.path / "no" / "s.json").string() + ": no folder " + (dir.path / "no").string() + " to write it in"},
+        // Found by audit (2026-12-07): refused only when the finished file was moved into place.
+        {{"render", spheres, "-o", (dir.path / (std::string(252, 'b') + ".png")).string()},
+         (dir.path / (std::string(252, 'b') + ".png")).string() +
+             ": the file's name is longer than the 255 bytes its folder's file system allows"},
         // Found by review (2026-12-06): a folder as --stats failed after the image was written, and
         // --stats naming the view file replaced it with --overwrite.
         {{"render", spheres, "-o", out, "--stats", folder_obj}, folder_obj + ": is a folder, not a file"},

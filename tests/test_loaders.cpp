@@ -655,6 +655,14 @@ TEST_F(LoaderTest, ViewFileKeysGivenTwiceAndOddMeshPathsAreNamed) {
         EXPECT_EQ(error_of([&] { load_scene(path); }), path + ": " + message) << text;
     }
     EXPECT_EQ(error_of([] { load_scene(""); }), "the scene's name is empty");
+    // Found by audit (2026-12-07): nested a million deep, a view file took 23 GB (every level named
+    // by its dotted path) before the system killed the program.
+    for (const std::string open : {"{\"a\":", "["}) {
+        std::string deep = "{\"camera\":";
+        for (int i = 0; i < 100000; ++i) deep += open;
+        const std::string path = write("deep.json", deep);
+        EXPECT_EQ(error_of([&] { load_scene(path); }), path + ": JSON nested deeper than 64 levels");
+    }
 }
 
 TEST_F(LoaderTest, ViewFileGivesMeshCameraLightAndSize) {
@@ -811,8 +819,14 @@ TEST_F(LoaderTest, ViewFileRejectsWrongTypes) {
         // Found by audit (2026-12-07): 3e38, a finite float, made a diffuse frame's pixels infinite.
         {[](json& d) { d["light"]["color"] = {1, 3e38, 1}; },
          "the light color has a channel above 1e+30, which the shading's sums could carry past float's range"},
-        {[](json& d) { d["name"] = 5; }, "field 'name' must be a string"},
-        {[](json& d) { d["name"] = nullptr; }, "field 'name' must be a string"},
+        {[](json& d) { d["name"] = 5; }, "field 'name' must be a non-empty string"},
+        {[](json& d) { d["name"] = nullptr; }, "field 'name' must be a non-empty string"},
+        // Found by audit (2026-12-07): an empty name began the summary line with ": "; a camera,
+        // light or image that is no object was named by its first field, as missing.
+        {[](json& d) { d["name"] = ""; }, "field 'name' must be a non-empty string"},
+        {[](json& d) { d["camera"] = nullptr; }, "field 'camera' must be an object"},
+        {[](json& d) { d["light"] = json::array(); }, "field 'light' must be an object"},
+        {[](json& d) { d["image"] = {64, 64}; }, "field 'image' must be an object"},
     };
     for (const Case& c : cases) {
         json doc = view_doc();

@@ -25,4 +25,8 @@ std::string default_scene_spec();
 
 Scene make_builtin_scene(const std::string& spec);
 
+// Throws as make_builtin_scene does for a bad spec, without making the triangles: a program can refuse
+// a mistyped scene before any work.
+void check_builtin_spec(const std::string& spec);
+
 }  // namespace cellrt

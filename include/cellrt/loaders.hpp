@@ -15,7 +15,9 @@
 namespace cellrt {
 
 // Wavefront OBJ: `v x y z [w]`, `f` with a, a/b, a//c, a/b/c and negative (relative) indices;
-// polygons are triangulated as fans; every other statement (vt, vn, g, o, s, usemtl, ...) is skipped.
+// polygons are triangulated as fans (`fo` read as `f`); statements that would change the geometry
+// unread (`call`, `csh`, free-form curves and surfaces), a `\` continuation and a CR before a line's
+// end are refused; every other statement (vt, vn, g, o, s, usemtl, ...) is skipped.
 std::vector<Triangle> load_obj(const std::string& path);
 
 // Stanford PLY, ASCII, binary_little_endian or binary_big_endian: x, y, z of element `vertex` (any
@@ -56,8 +58,11 @@ Scene load_view_file(const std::string& path);
 // The files loading the scene `spec` (load_scene's argument) reads, as (what, path), so that a
 // program can refuse an output that would replace one of them before any work: ("scene", spec); for
 // a view file, ("mesh", the mesh it names); for a .gltf file, itself or a view file's mesh, ("glTF
-// buffer", each external buffer it names, its URI as written); none for a built-in scene. A file that
-// cannot be read as JSON gives no more (loading it names what is wrong).
+// buffer", each external buffer it names, its URI as a path beside the .gltf file); none for a
+// built-in scene. A file that cannot be read as JSON gives no more (loading it names what is wrong).
 std::vector<std::pair<std::string, std::string>> scene_files(const std::string& spec);
+
+// The files of every scene in `specs`, in order (a sweep's inputs).
+std::vector<std::pair<std::string, std::string>> scene_files(const std::vector<std::string>& specs);
 
 }  // namespace cellrt

@@ -132,8 +132,9 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     }
     fs::rename(temp, target, ec);
     if (ec) {
+        const std::string why = ec.message();
         fs::remove(temp, ec);
-        throw Error(path + ": cannot move the finished file into place");
+        throw Error(path + ": cannot move the finished file into place (" + why + ")");
     }
 }
 
@@ -150,13 +151,20 @@ void check_output_file(const std::string& path, bool overwrite) {
         return;
     }
     if (kind == Target::file && !overwrite) throw Error(path + ": file exists (pass --overwrite to replace it)");
-    const fs::path dir = folder_of(file_named(path));
+    const fs::path file = file_named(path);
+    const fs::path dir = folder_of(file);
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path + ": no folder " + dir.string() + " to write it in");
     if (::access(dir.c_str(), W_OK | X_OK) != 0) {  // the temporary file is made there
         const int error = errno;
         throw Error(path + ": cannot write in the folder '" + dir.string() + "' (" + std::strerror(error) + ")");
     }
+    // A name the file system refuses was found when the finished file was moved into place, after
+    // the work (found by audit, 2026-12-07).
+    const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+    if (name_max > 0 && file.filename().string().size() > static_cast<std::size_t>(name_max))
+        throw Error(path + ": the file's name is longer than the " + std::to_string(name_max) +
+                    " bytes its folder's file system allows");
 }
 
 void check_output_folder(const std::string& option, const std::string& path) {

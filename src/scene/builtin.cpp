@@ -53,7 +53,15 @@ std::vector<BuiltinInfo> builtin_scenes() {
 
 std::string default_scene_spec() { return "builtin:city"; }
 
-Scene make_builtin_scene(const std::string& spec) {
+namespace {
+
+struct ParsedSpec {
+    const Generator* generator;
+    BuiltinParams params;
+};
+
+// The generator and parameters `spec` names; throws cellrt::Error naming what is wrong.
+ParsedSpec parse_spec(const std::string& spec) {
     if (spec.rfind("builtin:", 0) != 0) throw Error(spec + ": a built-in scene's spec starts with 'builtin:'");
     std::string_view rest = std::string_view(spec).substr(std::string_view("builtin:").size());
     const std::size_t q = rest.find('?');
@@ -68,12 +76,13 @@ Scene make_builtin_scene(const std::string& spec) {
     }
     BuiltinParams params;
     params.tris = gen->default_tris;
-    std::string_view query = q == std::string_view::npos ? std::string_view{} : rest.substr(q + 1);
     bool tris_given = false, seed_given = false;
-    while (!query.empty()) {
+    // After a '?', pairs separated by '&', none empty: "?" alone and a trailing '&' are refused as
+    // "&&" is (found by audit, 2026-12-07: they were accepted).
+    for (std::string_view query = q == std::string_view::npos ? std::string_view{} : rest.substr(q + 1);
+         q != std::string_view::npos;) {
         const std::size_t amp = query.find('&');
         const std::string_view pair = query.substr(0, amp);
-        query.remove_prefix(amp == std::string_view::npos ? query.size() : amp + 1);
         const std::size_t eq = pair.find('=');
         if (eq == std::string_view::npos) throw Error(spec + ": expected key=value, got '" + std::string(pair) + "'");
         const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
@@ -86,10 +95,21 @@ Scene make_builtin_scene(const std::string& spec) {
         } else {
             throw Error(spec + ": unknown key '" + std::string(key) + "' (known: tris, seed)");
         }
+        if (amp == std::string_view::npos) break;
+        query.remove_prefix(amp + 1);
     }
+    return {gen, params};
+}
+
+}  // namespace
+
+void check_builtin_spec(const std::string& spec) { parse_spec(spec); }
+
+Scene make_builtin_scene(const std::string& spec) {
+    const ParsedSpec parsed = parse_spec(spec);
     Scene scene;
-    scene.name = std::string(name);
-    gen->make(scene, params);
+    scene.name = parsed.generator->name;
+    parsed.generator->make(scene, parsed.params);
     validate_scene(scene, spec);
     return scene;
 }

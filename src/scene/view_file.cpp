@@ -67,6 +67,8 @@ class ViewReader {
 public:
     explicit ViewReader(const std::string& path) : path_(path) {}
 
+    static constexpr int kMaxDepth = 64;
+
     [[noreturn]] void fail(const std::string& field, const std::string& what) const {
         throw Error(path_ + ": field '" + field + "' " + what);
     }
@@ -75,6 +77,13 @@ public:
         const std::string name = parent_name.empty() ? key : parent_name + "." + key;
         if (!parent.is_object() || !parent.contains(key)) fail(name, "is missing");
         return parent.at(key);
+    }
+
+    // A field that holds fields: "camera": null was "field 'camera.position' is missing".
+    const json& object(const json& parent, const char* key) const {
+        const json& j = field(parent, "", key);
+        if (!j.is_object()) fail(key, "must be an object");
+        return j;
     }
 
     double number(const json& j, const std::string& name) const {
@@ -123,7 +132,11 @@ public:
         };
         std::vector<Object> objects;
         std::string key_name;  // the field the next object or value is, as "camera.position"
-        const json::parser_callback_t once = [&](int, json::parse_event_t event, json& parsed) {
+        const json::parser_callback_t once = [&](int depth, json::parse_event_t event, json& parsed) {
+            // A view file nests three levels deep ("camera", "position", its array); a file nested a
+            // million deep named every level by its dotted path, memory quadratic in the depth, and
+            // took 23 GB before the system killed it (found by audit, 2026-12-07).
+            if (depth > kMaxDepth) throw Error(path_ + ": JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
             if (event == json::parse_event_t::object_start) objects.push_back({key_name, {}});
             if (event == json::parse_event_t::object_end && !objects.empty()) {
                 key_name = objects.back().name;  // the next object in an array is named as this one
@@ -162,22 +175,23 @@ public:
 
         Scene scene;
         // Of the right type, as every other field: a name of 5 or null used to give way to the file's.
-        if (doc.contains("name") && !doc["name"].is_string()) fail("name", "must be a string");
+        if (doc.contains("name") && (!doc["name"].is_string() || doc["name"].get<std::string>().empty()))
+            fail("name", "must be a non-empty string");
         scene.name = doc.contains("name") ? doc["name"].get<std::string>() : std::filesystem::path(path_).stem().string();
-        const json& cam = field(doc, "", "camera");
+        const json& cam = object(doc, "camera");
         only(cam, "camera", {"position", "look_at", "up", "fov_y_deg"});
         scene.camera.position = vec3(cam, "camera", "position");
         scene.camera.look_at = vec3(cam, "camera", "look_at");
         scene.camera.up = vec3(cam, "camera", "up");
         scene.camera.fov_y_deg = static_cast<float>(number(field(cam, "camera", "fov_y_deg"), "camera.fov_y_deg"));
 
-        const json& light = field(doc, "", "light");
+        const json& light = object(doc, "light");
         only(light, "light", {"type", "position", "color"});
         if (light.contains("type") && light["type"] != "point") fail("light.type", "must be \"point\"");
         scene.light.position = vec3(light, "light", "position");
         if (light.contains("color")) scene.light.color = vec3(light, "light", "color");
 
-        const json& image = field(doc, "", "image");
+        const json& image = object(doc, "image");
         only(image, "image", {"width", "height"});
         scene.width = positive_int(image, "image", "width");
         scene.height = positive_int(image, "image", "height");
@@ -228,6 +242,13 @@ std::vector<std::pair<std::string, std::string>> scene_files(const std::string& 
     } catch (const std::exception&) {
         // Not a view file one can read: loading it says why.
     }
+    return files;
+}
+
+std::vector<std::pair<std::string, std::string>> scene_files(const std::vector<std::string>& specs) {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const std::string& spec : specs)
+        for (auto& file : scene_files(spec)) files.push_back(std::move(file));
     return files;
 }
 
