@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """A/B of two cellrt_bench builds by instruction counts. Each binary runs under callgrind on the
 same rays. For every scene, configuration and ray kind, the script reports the instructions (Ir) of
-one timed pass: primary rays through intersect, shadow rays through occluded. Each count is the
-inclusive cost of the bench's calls into the accelerator's entry point, so building the structures
-and making the rays are left out.
+one timed pass: primary rays through intersect, then the rays of the second kind (shadow, AO and
+random rays through occluded, diffuse bounces through intersect), which the bench's JSON and this
+table call "shadow" whatever their kind. Each count is the inclusive cost of the bench's calls into
+the accelerator's entry point, so building the structures and making the rays are left out.
 
 Why: on the shared VM, times of whole runs vary by +-10% (docs/BENCHMARKS.md), which is more than
 the 2% to be shown. Instruction counts repeat exactly from run to run. They are not time: they do
@@ -14,9 +15,9 @@ look.
 How: callgrind starts a new dump each time clock_gettime is called (--dump-before), and cellrt_bench
 reads the clock just before and just after every pass. So each pass is a dump of its own, whether a
 run traces one configuration or all of them (the counts are the same either way). A round is a
-primary dump, then tiny gap dumps only, then a shadow dump. For each scene the bench runs one
-warm-up round per configuration, then --repeats more; the last round is the one reported. Under
-valgrind '+auto' resolves to avx2, because valgrind has no AVX-512.
+primary dump, then gap dumps (calling neither entry point, or tiny), then the second kind's dump. For each
+scene the bench runs one warm-up round per configuration, then --repeats more; the last round is the
+one reported. Under valgrind '+auto' resolves to avx2, because valgrind has no AVX-512.
 
 With --cache-sim, callgrind also simulates the data caches (Zen 3's: 32 KiB first level, 512 KiB
 second) and the table adds the first- and second-level data misses per ray of the same calls: the
@@ -92,6 +93,18 @@ def dump_counts(path):
     return total, cost["intersect"], cost["occluded"]
 
 
+# The ray kinds answered by intersect (closest hit); every other kind goes through occluded.
+CLOSEST_KINDS = {"primary", "bounce"}
+
+
+def pass_cost(dump, call):
+    """The costs of `dump` when it is one pass through `call` ("intersect" or "occluded"): all but 1 % of
+    its instructions inside that call and none in the other; None otherwise."""
+    total, intersect, occluded = dump
+    mine, other = (intersect, occluded) if call == "intersect" else (occluded, intersect)
+    return mine if mine.get("Ir", 0) > 0.99 * total and not other else None
+
+
 # The cache simulation's geometry, the Zen 3 cores this was measured on: 32 KiB 8-way first-level data
 # (and instruction) cache, 512 KiB 8-way second level (callgrind's "LL"), 64-byte lines.
 CACHE_SIM = ["--cache-sim=yes", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=524288,8,64"]
@@ -107,29 +120,36 @@ def run(binary, configs, args, keep, cache_sim):
            "--json", bench_json]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{res.stderr[-2000:]}")
+        sys.exit(f"ab_callgrind.py: error: {' '.join(cmd)} failed:\n{res.stderr[-2000:]}")
+    rows = json.load(open(bench_json))
+    # The second pass calls what its kind asks (closest_hit() in workload.hpp): intersect for bounce
+    # rays (--rays diffuse), occluded for shadow, AO and random any-hit rays. A bench older than
+    # --rays ao/diffuse writes no shadow_kind: its second kind is shadow.
+    kinds = {r.get("shadow_kind", "shadow") for r in rows}
+    if len(kinds) != 1:
+        sys.exit(f"ab_callgrind.py: error: {binary}: second ray kinds {sorted(kinds)}, expected one")
+    second = "intersect" if kinds <= CLOSEST_KINDS else "occluded"
     files = sorted(glob.glob(f"{d}/cg.out.*"), key=lambda p: int(p.rsplit(".", 1)[1]))
     dumps = [dump_counts(p) for p in files]
     rounds, i = [], 0
     while i < len(dumps):
-        t, ni, no = dumps[i]
-        if ni.get("Ir", 0) > 0 and not no and ni["Ir"] > 0.99 * t:
+        if pass_cost(dumps[i], "intersect"):
             j = i + 1
-            while j < len(dumps) and dumps[j][0] < 10000:
+            # Gaps: dumps that call neither entry point, or tiny ones that are no pass of the second
+            # kind (the route's own clock reads inside a pass cut a few calls into dumps of their own).
+            while j < len(dumps) and not pass_cost(dumps[j], second) and (not any(dumps[j][1:]) or dumps[j][0] < 10000):
                 j += 1
-            if (j < len(dumps) and dumps[j][2].get("Ir", 0) > 0 and not dumps[j][1]
-                    and dumps[j][2]["Ir"] > 0.99 * dumps[j][0]):
-                rounds.append((ni, dumps[j][2]))
+            if j < len(dumps) and pass_cost(dumps[j], second):
+                rounds.append((pass_cost(dumps[i], "intersect"), pass_cost(dumps[j], second)))
                 i = j
         i += 1
     # Per scene, the bench traces its configurations in turn: a warm-up round, then --repeats rounds.
-    rows = json.load(open(bench_json))
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     traced = [[r for r in rows if r["scene"] == s] for s in scenes]
     passes = 1 + int(option_values(args, "--repeats", ["5"])[0])
     if len(rounds) != passes * len(rows):
-        sys.exit(f"{binary}: {len(rounds)} pass rounds for {len(rows)} (scene, config) rows x {passes}; "
-                 f"rerun with --keep to look at the dumps")
+        sys.exit(f"ab_callgrind.py: error: {binary}: {len(rounds)} pass rounds for {len(rows)} (scene, config) "
+                 f"rows x {passes}; rerun with --keep to look at the dumps")
     out, k = {}, 0
     for rs in traced:
         mine = rounds[k:k + passes * len(rs)]

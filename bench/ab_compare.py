@@ -5,7 +5,8 @@ the median time of A (primary and shadow rays, and both). Interleaving whole run
 machine's slow spells over both builds; the Embree configurations, the same code in both, show how
 much noise is left.
 
-    bench/ab_compare.py OLD/cellrt_bench NEW/cellrt_bench --rounds 4 --json out.json -- [cellrt_bench options]
+    bench/ab_compare.py OLD/cellrt_bench NEW/cellrt_bench --rounds 4 --json out.json [--overwrite] -- \
+        [cellrt_bench options]
 """
 import argparse
 import json
@@ -21,7 +22,9 @@ def run(binary, args):
     # which older binaries, also compared here, do not take.
     with tempfile.TemporaryDirectory() as d:
         path = os.path.join(d, "run.json")
-        subprocess.run([binary, *args, "--json", path], check=True, stdout=subprocess.DEVNULL)
+        res = subprocess.run([binary, *args, "--json", path], stdout=subprocess.DEVNULL)
+        if res.returncode != 0:  # its own message is on stderr already
+            sys.exit(f"ab_compare.py: error: {binary} failed (status {res.returncode})")
         with open(path) as f:
             return json.load(f)
 
@@ -32,10 +35,22 @@ def main():
     ap.add_argument("b")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--json", help="write every run's rows and the ratios here")
+    ap.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
     argv = sys.argv[1:]
     split = argv.index("--") if "--" in argv else len(argv)
     o = ap.parse_args(argv[:split])
     args = argv[split + 1:]
+    # Refused before the runs, which take minutes, as cellrt_bench refuses its own options.
+    if o.rounds < 1:
+        ap.error(f"--rounds {o.rounds}: must be 1 or more")
+    if o.json:
+        folder = os.path.dirname(os.path.abspath(o.json))
+        if not os.path.isdir(folder):
+            ap.error(f"--json {o.json}: no folder {folder} to write it in")
+        if os.path.isdir(o.json):
+            ap.error(f"--json {o.json}: is a folder")
+        if os.path.exists(o.json) and not o.overwrite:
+            ap.error(f"--json {o.json}: file exists (pass --overwrite to replace it)")
     times = {"a": {}, "b": {}}
     runs = []
     for r in range(o.rounds):

@@ -66,10 +66,7 @@ inline void check_results_paths(const std::vector<std::pair<std::string, std::st
         if (!cluster::leader()) return;
         for (const auto& [option, path] : outputs)
             if (!path.empty()) check_output_file(path, overwrite);
-        std::vector<std::pair<std::string, std::string>> inputs;
-        for (const std::string& spec : specs)
-            for (auto& file : scene_files(spec)) inputs.push_back(std::move(file));
-        check_distinct_files(outputs, inputs);
+        check_distinct_files(outputs, scene_files(specs));
     }, "checking the results' paths");
 }
 

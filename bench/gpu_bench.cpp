@@ -257,10 +257,9 @@ int main(int argc, char** argv) {
     try {
         if (!o.json_path.empty()) {
             check_output_file(o.json_path, o.overwrite);
-            std::vector<std::pair<std::string, std::string>> inputs;
-            for (const std::string& name : o.scenes)
-                for (auto& file : scene_files(bench::scene_file(o.scenes_dir, name))) inputs.push_back(std::move(file));
-            check_distinct_files({{"--json", o.json_path}}, inputs);
+            std::vector<std::string> specs;
+            for (const std::string& name : o.scenes) specs.push_back(bench::scene_file(o.scenes_dir, name));
+            check_distinct_files({{"--json", o.json_path}}, scene_files(specs));
         }
     } catch (const Error& e) {
         cli::cluster::print_error(e);

@@ -12,6 +12,7 @@ would. Medians of --repeats runs of each; the ratio is Python's rays/s over C++'
 import argparse
 import os
 import statistics
+import sys
 import time
 
 import numpy as np
@@ -40,11 +41,51 @@ def arguments(doc, kinds, repeats, threads, side):
     return parser
 
 
+def checked(parser, args, default_kind=False):
+    """`args` with --kinds as a list, refused before the scene loads: a kind the library does not take
+    (its own message, from a build over one triangle, so a bad traversal is caught too), a kind named
+    twice, --repeats or --side below 1. `default_kind`: `default` names kind=None. Embree's kinds are
+    skipped with a note where the library has no Embree, as cellrt_bench skips them."""
+    for name in ("repeats", "side"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} {getattr(args, name)}: must be 1 or more")
+    kinds = args.kinds.split(",")
+    twice = sorted({k for k in kinds if kinds.count(k) > 1})
+    if twice:
+        parser.error(f"--kinds names {', '.join(twice)} more than once")
+    triangle = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], np.float32)
+    args.kinds = []
+    for k in kinds:
+        if k.split(":")[0] == "embree" and "embree" not in cellrt.kinds():
+            print(f"skipping {k}: this cellrt has no Embree", file=sys.stderr)
+            continue
+        try:
+            cellrt.Accelerator(triangle, kind=None if default_kind and k == "default" else k)
+        except ValueError as e:
+            parser.error(f"--kinds {k}: {e}")
+        args.kinds.append(k)
+    if not args.kinds:
+        parser.error("--kinds: none left to measure")
+    return args
+
+
+def check_output(parser, option, path, overwrite):
+    """Refuses, before any work, an output `path` whose folder is not there, or a file there already
+    without --overwrite (cellrt_bench's rules and words)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        parser.error(f"{option} {path}: no folder {folder} to write it in")
+    if os.path.isdir(path):
+        parser.error(f"{option} {path}: is a folder")
+    if os.path.exists(path) and not overwrite:
+        parser.error(f"{option} {path}: file exists (pass --overwrite to replace it)")
+
+
 def main():
     parser = arguments(__doc__, "kd,bvh", 9, 0, 1024)
     parser.add_argument("--clock", choices=["wall", "cpu"], default="wall",
                         help="cpu: the process's CPU time, all threads (steadier on a shared machine)")
-    args = parser.parse_args()
+    args = checked(parser, parser.parse_args())
     clock = time.process_time if args.clock == "cpu" else time.perf_counter
     scene = cellrt.load_scene(args.scene)
     batches = {"camera": scene.camera.rays(args.side, args.side),
@@ -52,7 +93,7 @@ def main():
     print(f"{scene.name}: {len(scene.triangles)} triangles, batches of {args.side * args.side} rays, "
           f"threads {args.threads or os.cpu_count()}, median of {args.repeats}, {args.clock} clock")
     print(f"{'kind':6} {'rays':11} {'Python Mrays/s':>15} {'C++ Mrays/s':>12} {'ratio':>7}")
-    for kind in args.kinds.split(","):
+    for kind in args.kinds:
         acc = cellrt.Accelerator(scene.triangles, kind=kind, threads=args.threads)
         for name, (o, d) in batches.items():
             n = len(o)

@@ -2,7 +2,8 @@
 """What a Python user gets from each kind: build time and rays per second, Embree beside them.
 
     PYTHONPATH=build/python python3 bench/python_kinds.py [SCENE] [--kinds default,auto,kd,bvh,embree]
-                                                          [--threads 1] [--repeats 5] [--side 512] [--json F]
+                                                          [--threads 1] [--repeats 5] [--side 512]
+                                                          [--json F [--overwrite]]
 
 Per kind (`default` is kind=None, the library's default), the build is timed --repeats times and one
 accelerator then traces, in rounds that take the kinds in turn: the camera's primary rays (SIDE x SIDE,
@@ -17,14 +18,17 @@ import statistics
 import time
 
 import cellrt
-from python_bench import arguments, incoherent_rays
+from python_bench import arguments, check_output, checked, incoherent_rays
 
 
 def main():
     parser = arguments(__doc__, "default,auto,kd,bvh,embree,embree:packet16", 5, 1, 512)
     parser.add_argument("--json", help="write the medians as JSON")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
     parser.add_argument("--render", action="store_true", help="also time a whole render, build included")
-    args = parser.parse_args()
+    args = checked(parser, parser.parse_args(), default_kind=True)
+    if args.json:
+        check_output(parser, "--json", args.json, args.overwrite)
     clock = time.process_time
     scene = cellrt.load_scene(args.scene)
     camera = scene.camera.rays(args.side, args.side)
@@ -32,7 +36,7 @@ def main():
     loads = {"camera": lambda a: a.intersect(*camera),
              "incoherent closest": lambda a: a.intersect(*incoherent),
              "incoherent any": lambda a: a.occluded(*incoherent)}
-    kinds = [k for k in args.kinds.split(",") if k.split(":")[0] in cellrt.kinds() or k == "default"]
+    kinds = args.kinds
 
     def build(kind):
         return cellrt.Accelerator(scene.triangles, kind=None if kind == "default" else kind, threads=args.threads)

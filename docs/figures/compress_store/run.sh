@@ -6,7 +6,7 @@ set -e
 D=docs/figures/compress_store
 OLD=${1:?usage: run.sh OLD/cellrt_bench}
 for k in random ao diffuse frame; do
-  python3 bench/ab_compare.py "$OLD" build/bench/cellrt_bench --rounds 3 --json $D/ab_$k.json -- \
+  python3 bench/ab_compare.py "$OLD" build/bench/cellrt_bench --overwrite --rounds 3 --json $D/ab_$k.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh bvh:wide bvh:packet auto \
     --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/ab_$k.md
 done
@@ -25,7 +25,7 @@ python3 $D/two_workers/table.py > $D/two_workers/table.md
 # it (BEFORE_MASK, the push change alone) against the new one, two rounds:
 if [ -n "$BEFORE_MASK" ]; then
   for k in ao frame; do
-    python3 bench/ab_compare.py "$BEFORE_MASK" build/bench/cellrt_bench --rounds 2 --json $D/mask_compare_$k.json -- \
+    python3 bench/ab_compare.py "$BEFORE_MASK" build/bench/cellrt_bench --overwrite --rounds 2 --json $D/mask_compare_$k.json -- \
       --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/mask_compare_$k.md
   done
@@ -36,7 +36,7 @@ python3 docs/figures/kd_octant/state/kd_branched_ratio.py docs/figures/compress_
 for v in 5_1 8_1 3_2 3_3; do
   [ -x "$B_DIR/b_$v" ] || continue
   for k in ao frame diffuse; do
-    python3 bench/ab_compare.py "$B_DIR/b0" "$B_DIR/b_$v" --rounds 2 --json $D/single_below/${v}_$k.json -- \
+    python3 bench/ab_compare.py "$B_DIR/b0" "$B_DIR/b_$v" --overwrite --rounds 2 --json $D/single_below/${v}_$k.json -- \
       --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/single_below/${v}_$k.md
   done
@@ -44,7 +44,7 @@ done
 # not_kept/wl_*: watertight_leaf marked [[gnu::always_inline]] (B_WL), against the kept build (B_BASE):
 if [ -n "$B_WL" ]; then
   for k in random ao diffuse; do
-    python3 bench/ab_compare.py "$B_BASE" "$B_WL" --rounds 2 --json $D/not_kept/wl_$k.json -- \
+    python3 bench/ab_compare.py "$B_BASE" "$B_WL" --overwrite --rounds 2 --json $D/not_kept/wl_$k.json -- \
       --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh bvh:packet bvh:stream \
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/not_kept/wl_$k.md
   done
@@ -54,20 +54,20 @@ fi
 if [ -n "$B_IN_PLACE" ]; then
   python3 bench/ab_callgrind.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --json $D/in_place/callgrind_frame.json -- \
     --scenes-dir ../shared/scenes --scenes sponza bunny --configs kd+auto --rays frame --size 128x128 --repeats 1 --builds 1
-  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --rounds 3 --json $D/in_place/time_frame_1.json -- \
+  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --overwrite --rounds 3 --json $D/in_place/time_frame_1.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto bih+auto \
     --rays frame --repeats 5 --builds 1 --size 256x256 --clock cpu
-  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --rounds 3 --json $D/in_place/time_frame_2.json -- \
+  python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --overwrite --rounds 3 --json $D/in_place/time_frame_2.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto \
     --rays frame --repeats 7 --builds 1 --size 256x256 --clock cpu
 fi
 # coherence/: batch_coherence over 16 pairs (B_PAIRS16) against 64 (B_PAIRS64): perf of auto on the
 # teapot's random rays (perf.txt) and two A/B runs.
 if [ -n "$B_PAIRS16" ]; then
-  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --rounds 3 --json $D/coherence/ab_random.json -- \
+  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --overwrite --rounds 3 --json $D/coherence/ab_random.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet8 bvh auto \
     --rays random --repeats 5 --builds 1 --size 256x256 --clock cpu
-  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --rounds 3 --json $D/coherence/ab_ao.json -- \
+  python3 bench/ab_compare.py "$B_PAIRS64" "$B_PAIRS16" --overwrite --rounds 3 --json $D/coherence/ab_ao.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
     --rays ao --repeats 5 --builds 1 --size 256x256 --clock cpu
 fi
@@ -80,10 +80,10 @@ if [ -n "$B_LL" ]; then
   python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --json $D/leaf_lanes/callgrind_ao.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik --configs bvh:packet --rays ao --size 128x128 --repeats 1 --builds 1
   for k in frame ao diffuse; do
-    python3 bench/ab_compare.py "$B_BEFORE_LL" "$B_LL" --rounds 3 --json $D/leaf_lanes/time_$k.json -- \
+    python3 bench/ab_compare.py "$B_BEFORE_LL" "$B_LL" --overwrite --rounds 3 --json $D/leaf_lanes/time_$k.json -- \
       --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet auto \
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu > $D/leaf_lanes/time_$k.md
-    python3 bench/ab_compare.py "$B_LL" "$B_LL2" --rounds 3 --json $D/leaf_lanes/time_ll2_vs_ll1_$k.json -- \
+    python3 bench/ab_compare.py "$B_LL" "$B_LL2" --overwrite --rounds 3 --json $D/leaf_lanes/time_ll2_vs_ll1_$k.json -- \
       --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 bvh:packet \
       --rays $k --repeats 5 --builds 1 --size 256x256 --clock cpu
   done

@@ -4,14 +4,14 @@
 OLD=${OLD:-/tmp/old/build} NEW=${NEW:-build} out=docs/figures/incoherent_round10
 # 1. Time: old against new, four rounds (a b b a a b b a), Embree in every run.
 for kind in random diffuse frame; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 4 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 4 \
     --json $out/ab_${kind}.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik bunny teapot --size 256x256 --repeats 9 --builds 1 --clock cpu --rays $kind \
     --configs embree:single embree:packet8 bvh auto
 done
 # 1b. The same at 512 x 512 (random and diffuse rays), the files ab512_*.json.
 for kind in random diffuse; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 4 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 4 \
     --json $out/ab512_${kind}.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik bunny teapot --size 512x512 --repeats 9 --builds 1 --clock cpu --rays $kind \
     --configs embree:single embree:packet8 bvh auto

@@ -5,7 +5,7 @@ OLD=${OLD:-/tmp/old/build} NEW=${NEW:-build} out=docs/figures/incoherent_round11
 S="--scenes-dir ../shared/scenes"
 # 1. The single-ray kernel, now a loop over bvh_step: old against new, three rounds (a b b a a b).
 for kind in random frame; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 3 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 3 \
     --json $out/ab_${kind}.json -- $S --scenes sponza sibenik bunny teapot --size 256x256 --repeats 9 \
     --builds 1 --clock cpu --rays $kind --configs embree:single embree:packet8 bvh
 done
@@ -20,7 +20,7 @@ python3 $out/summary.py $out/ab_random.json $out/ab_frame.json
 python3 $out/paired.py $out/paired_*.json
 # 3. `auto`, whose BVH path is now bvh:paired: old against new, three rounds.
 for kind in random ao diffuse frame; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 3 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 3 \
     --json $out/ab_auto_${kind}.json -- $S --scenes sponza sibenik bunny teapot --size 256x256 --repeats 9 \
     --builds 1 --clock cpu --rays $kind --configs embree:single embree:packet8 auto
 done

@@ -6,7 +6,7 @@ OLD=${OLD:-/tmp/ab/cellrt_bench.old}
 NEW=${NEW:-build/bench/cellrt_bench}
 D=docs/figures/incoherent_round12
 for k in frame ao diffuse random; do
-  python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_$k.json -- \
+  python3 bench/ab_compare.py $OLD $NEW --overwrite --rounds 3 --json $D/ab_$k.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:single embree:packet8 bvh:packet bvh:stream auto | grep '|' > $D/ab_$k.md
 done
@@ -15,7 +15,7 @@ done
 bench/incoherent_state.sh $D $NEW
 # The million-triangle forest (a 75 MiB tree, beyond the 32 MiB L3), old against new:
 for k in frame ao; do
-  python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_forest_$k.json -- \
+  python3 bench/ab_compare.py $OLD $NEW --overwrite --rounds 3 --json $D/ab_forest_$k.json -- \
     --scenes 'builtin:forest?tris=1000000' --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:packet8 embree:packet16 bvh:packet bvh:stream | grep '|' > $D/ab_forest_$k.md
 done

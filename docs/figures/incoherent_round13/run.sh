@@ -6,7 +6,7 @@ OLD=${OLD:-/tmp/ab/old_bench}
 NEW=${NEW:-build/bench/cellrt_bench}
 D=docs/figures/incoherent_round13
 for k in random ao frame diffuse; do
-  python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_$k.json -- \
+  python3 bench/ab_compare.py $OLD $NEW --overwrite --rounds 3 --json $D/ab_$k.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:single embree:packet8 embree:packet16 bvh:paired bvh:stream bvh:packet auto \
     | grep '|' > $D/ab_$k.md

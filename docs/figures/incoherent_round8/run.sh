@@ -3,7 +3,7 @@
 # post-stratified times (NEW), from the repository root, OLD and NEW each a build folder.
 OLD=${OLD:-/tmp/old/build} NEW=${NEW:-build} out=docs/figures/incoherent_round8
 for kind in frame ao diffuse random; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 3 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 3 \
     --json $out/ab_${kind}.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $kind \
     --configs embree:single embree:packet8 auto bvh:packet

@@ -14,7 +14,7 @@ done
 # 3. `auto` (whose BVH takes the default) old against new, three rounds (a b b a a b), on the two scenes
 #    whose trees change.
 for kind in frame ao diffuse random; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --rounds 3 \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --rounds 3 \
     --json $out/ab_${kind}.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik --size 256x256 --repeats 5 --builds 1 --clock cpu --rays $kind \
     --configs embree:single embree:packet8 auto bvh:packet

@@ -5,11 +5,11 @@
 D=docs/figures/kd_octant
 OLD=/tmp/kdwide/cellrt_bench.old
 NEW=build/bench/cellrt_bench
-python3 bench/ab_compare.py $OLD $NEW --rounds 3 --json $D/ab_frame.json -- \
+python3 bench/ab_compare.py $OLD $NEW --overwrite --rounds 3 --json $D/ab_frame.json -- \
   --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
   --clock cpu --rays frame --configs embree:single kd:rec kd:branched kd:branchless bih:branched | grep '^|' > $D/ab_frame.md
 for rays in random ao; do
-  python3 bench/ab_compare.py $OLD $NEW --rounds 2 --json $D/ab_$rays.json -- \
+  python3 bench/ab_compare.py $OLD $NEW --overwrite --rounds 2 --json $D/ab_$rays.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $rays --configs embree:single kd:rec kd:branched bih:branched kd+auto | grep '^|' > $D/ab_$rays.md
 done

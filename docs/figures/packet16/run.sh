@@ -5,7 +5,7 @@
 OLD=${1:?usage: run.sh OLD/cellrt_bench NEW/cellrt_bench [ROUTE_OLD ROUTE_NEW]}; NEW=${2:?}
 D=docs/figures/packet16
 for rays in ao frame diffuse; do
-  bench/ab_compare.py $OLD $NEW --rounds 2 --json $D/time_$rays.json -- --scenes-dir ../shared/scenes \
+  bench/ab_compare.py $OLD $NEW --overwrite --rounds 2 --json $D/time_$rays.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik bunny teapot --size 256x256 --repeats 3 --builds 1 --rays $rays --clock cpu \
     --configs embree:packet16 bvh:packet auto
 done
@@ -21,7 +21,7 @@ for i in 1 2; do  # auto against auto@packets=bvh on Sibenik's AO rays, the old 
     --clock cpu --configs embree:packet16 bvh:packet bvh:stream auto auto@packets=bvh --json $D/route_sib_$i.json
 done
 for rays in ao diffuse random frame; do
-  bench/ab_compare.py $ROUTE_OLD $ROUTE_NEW --rounds 2 --json $D/route_$rays.json -- --scenes-dir ../shared/scenes \
+  bench/ab_compare.py $ROUTE_OLD $ROUTE_NEW --overwrite --rounds 2 --json $D/route_$rays.json -- --scenes-dir ../shared/scenes \
     --scenes sponza sibenik bunny teapot --size 256x256 --repeats 3 --builds 1 --rays $rays --clock cpu \
     --configs embree:packet16 auto
 done

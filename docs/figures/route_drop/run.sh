@@ -15,7 +15,7 @@ for s in sponza bunny; do
 done
 (cd $D && python3 table.py > table.md)
 for k in frame ao; do
-  python3 bench/ab_compare.py $OLD/bench/cellrt_bench build/bench/cellrt_bench --rounds 2 --json $D/ab_$k.json -- \
+  python3 bench/ab_compare.py $OLD/bench/cellrt_bench build/bench/cellrt_bench --overwrite --rounds 2 --json $D/ab_$k.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --size 256x256 --repeats 5 --builds 1 \
     --clock cpu --rays $k --configs embree:packet16 auto auto@packets=bvh 2>/dev/null | grep "^|" > $D/ab_$k.md
 done
