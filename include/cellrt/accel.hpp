@@ -47,7 +47,8 @@ AccelConfig parse_accel_config(std::string spec);
 // The configuration written as parse_accel_config reads it, in one canonical form: the traversal when
 // named, the SIMD set unless "off", the parameters sorted by name (e.g. "auto@packets=bvh"). The
 // threads and the device are not part of the string. parse_accel_config of the result gives back
-// `config`'s kind, traversal, SIMD set and parameters.
+// `config`'s kind, traversal, SIMD set and parameters, where no parameter's value holds a ',' (no
+// structure accepts one).
 std::string format_accel_config(const AccelConfig& config);
 
 // What a caller who names no configuration gets (the C API's NULL, Python's kind=None). On the CPU,

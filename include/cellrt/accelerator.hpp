@@ -69,18 +69,19 @@ struct TreeReport {
 // What a built accelerator reports: typed figures for code, and figures() for people.
 struct AccelStats {
     std::string name;             // the kind
-    std::string traversal;        // the single-ray kernel, "packet" (SIMD packets), or Embree's
+    std::string traversal;        // the single-ray kernel, "packet" (SIMD packets), "auto" (the route), or Embree's
     int simd_lanes = 0;           // rays a SIMD packet traces at once; 0: single rays
     double build_seconds = 0.0;
     double build_cpu_seconds = 0.0;  // the process's CPU time over the build, all threads together
     std::size_t memory_bytes = 0;
     std::size_t triangles = 0;
-    std::optional<TreeReport> tree;  // kd-tree and BIH
+    std::optional<TreeReport> tree;  // kd-tree, BIH and the wide BVH
     // The build settings as used (name, value), in print order: the structure's parameters that shape
     // its build, Embree's flags, the local store's layout.
     std::vector<std::pair<std::string, std::string>> settings;
 
-    // The printed report, in print order: every field above as (name, value).
+    // The printed report, in print order, as (name, value): the fields above but the name, the build
+    // times and the memory, which a program prints beside it.
     std::vector<std::pair<std::string, std::string>> figures() const;
     // The value of setting `name`, or nullopt.
     std::optional<std::string> setting(const std::string& name) const;
@@ -90,7 +91,8 @@ class Accelerator {
 public:
     virtual ~Accelerator() = default;
 
-    // Closest hit of each ray under the hit rule of ray.hpp. Throws cellrt::Error when hits.size()
+    // Closest hit of each ray under the hit rule of ray.hpp (Embree's own test and rule for the
+    // `embree` kind: docs/EMBREE.md). Throws cellrt::Error when hits.size()
     // differs from rays.size() (checked once per call, before any ray is traced), and, for Embree,
     // for a ray outside its domain (a negative tnear, a component beyond 1.844e18: docs/EMBREE.md),
     // after which `hits` may be partly written; an exception from the structure (a GPU's failure)

@@ -100,8 +100,8 @@ public:
     // height, row-major). `triangles` are the scene's, those the tree was built over (a hit names
     // one); they are copied in for the call, the pixels out. Adds the primary rays' work to `primary`
     // and every other ray's to `secondary`. Thread-safe as intersect() is. Throws cellrt::Error for
-    // an empty window, a pixel count that does not match, triangles that are not the tree's, or a
-    // CUDA failure.
+    // an empty window, a pixel count that does not match, a triangle count other than the tree's (the
+    // triangles themselves are not compared), or a CUDA failure.
     struct FrameResult {
         double kernel_seconds = 0.0;  // the kernel's own time (CUDA events): no copies
         double seconds = 0.0;         // the whole call: triangles in, kernel, pixels out

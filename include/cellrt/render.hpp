@@ -50,7 +50,8 @@ struct RenderStats {
 // (from `progress`) is refused.
 // Given a device accelerator (cellrt/device.hpp) the frame is made on the device instead, one GPU
 // thread a pixel (DeviceAccelerator::render_frame), with the same pixels bit for bit; the packet
-// edge, workers, dispatch and pinning then play no part, and progress is reported once, at the end.
+// edge is still checked, the workers, dispatch and pinning play no part, progress is reported once,
+// at the end, and device frames do not take the CPU frames' turns (nor are they refused inside one).
 Image render(const Scene& scene, const Accelerator& accel, const RenderOptions& options,
              RenderStats* stats = nullptr);
 

@@ -1,5 +1,5 @@
 // A scene: triangles, a pinhole camera, one point light and an image size, loaded from a view file,
-// a bare mesh (OBJ or PLY, with a default view) or a built-in procedural generator.
+// a bare mesh (OBJ, PLY or glTF, with a default view) or a built-in procedural generator.
 #pragma once
 
 #include <string>
@@ -43,7 +43,7 @@ struct Scene {
 };
 
 // Loads `spec`: a view file (*.json, format of shared/scenes/README.md), a mesh (*.obj, *.ply, *.gltf,
-// *.glb) shown by default_view() (a glTF file by its first perspective camera where it has one), or `builtin:NAME[?key=value&...]` (builtin.hpp). Throws cellrt::Error with a
+// *.glb) shown by set_default_view() (a glTF file by its first perspective camera where it has one), or `builtin:NAME[?key=value&...]` (builtin.hpp). Throws cellrt::Error with a
 // message naming the file and line or the field at fault.
 Scene load_scene(const std::string& spec);
 
@@ -59,7 +59,9 @@ void set_default_view(Scene& scene);
 std::string default_view_problem(const Scene& scene, bool camera_too = true);
 
 // Checks what every loader guarantees: at least one triangle, all coordinates finite, a valid camera
-// (see PinholeCamera) and a positive image size. Throws cellrt::Error naming `where` otherwise.
+// (see PinholeCamera), a finite light position, a light colour of finite, non-negative channels of at
+// most kMaxLightChannel, and an image size check_image_size accepts. Throws cellrt::Error naming
+// `where` otherwise.
 void validate_scene(const Scene& scene, const std::string& where);
 
 }  // namespace cellrt
