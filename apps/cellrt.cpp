@@ -53,7 +53,11 @@ int run(int argc, char** argv) {
         cli::cluster::agree(kNames[chosen], "comparing the commands", [](const std::string& mine, const std::string& leaders) {
             return "it runs " + mine + ", rank 0 " + leaders;
         });
-        return runners.at(chosen)();
+        const int status = runners.at(chosen)();
+        // A signal in a Cancellable section after its last poll (during the writing of the outputs,
+        // which finished whole) still ends the run as interrupted (found by review, 2026-12-07).
+        if (status == 0 && cli::g_cancel.load()) throw Error("interrupted (the outputs were written whole)");
+        return status;
     } catch (const Error& e) {
         cli::cluster::print_error(e);
         return cli::g_cancel.load() ? 130 : 1;

@@ -141,7 +141,7 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
     return accel;
 }
 
-void check_structure(const AccelOptions& options) {
+AccelConfig check_names(const AccelOptions& options) {
     const AccelConfig config = options.config();
     // The library's words for an unknown kind or traversal, behind the option that gave it.
     const std::vector<std::string> kinds = accelerator_kinds();
@@ -159,6 +159,11 @@ void check_structure(const AccelOptions& options) {
         throw Error((options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'") +
                     ": " + config.kind + " has no traversal '" + config.traversal + "' (it has: " + offered + ")");
     }
+    return config;
+}
+
+void check_structure(const AccelOptions& options) {
+    const AccelConfig config = check_names(options);
     static const Triangle kOne{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
     build_structure(std::span<const Triangle>(&kOne, 1), config, options);
 }

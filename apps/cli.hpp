@@ -82,6 +82,10 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
 // `info` printed half its report), in the words of the option that gave it.
 void check_structure(const AccelOptions& options);
 
+// options.config(), its kind and traversal checked against the library's and refused in the words of
+// the option that gave them (what check_structure does before it builds).
+AccelConfig check_names(const AccelOptions& options);
+
 void print_stats(const AccelStats& s);
 
 // A CLI11 check that refuses an empty value (an option given as "" means no default).

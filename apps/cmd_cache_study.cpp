@@ -455,7 +455,9 @@ Runner add_cache_study(CLI::App& app) {
             Timer timer;
             const std::vector<Result> results = [&] {
                 const Cancellable cancellable;
-                return gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
+                std::vector<Result> r = gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
+                if (g_cancel) throw Error("cache study cancelled");  // during the last run or the gather
+                return r;
             }();
             if (!cluster::leader()) continue;
             if (gpu)
@@ -478,7 +480,7 @@ Runner add_cache_study(CLI::App& app) {
             for (const std::string& key : group_order) md += best_layout_line(scene.name, runs, results, groups[key]);
         }
         if (!cluster::leader()) return 0;
-        const Cancellable cancellable;  // a signal while the results are written is seen after: both whole
+        const Cancellable cancellable;  // a signal while the results are written is seen after (run): both whole
         std::error_code ec;
         std::filesystem::create_directories(o->out, ec);
         if (!std::filesystem::is_directory(o->out, ec)) throw Error("--out '" + o->out + "': cannot create the folder");

@@ -221,8 +221,9 @@ profile::RegionCounts event_counts(const Scene& scene, const Accelerator& accel,
     if (hardware) return profile::measure_with_counters(scene, accel, ro);
     profile::RegionCounts counts;
     for (const profile::Region r : {profile::Region::render, profile::Region::traversal}) {
-        const profile::EventCounts c =
-            profile::run_callgrind(child_command(scene_spec, config, ro, r), profile::callgrind_options(r));
+        profile::CallgrindOptions options = profile::callgrind_options(r);
+        options.cancel = &g_cancel;  // a signal kills the run and removes its folder (Cancellable below)
+        const profile::EventCounts c = profile::run_callgrind(child_command(scene_spec, config, ro, r), options);
         (r == profile::Region::render ? counts.render : counts.traversal) = c;
     }
     return counts;
@@ -290,6 +291,7 @@ int run_profile(const ProfileOptions& o) {
     p.work = counted_work(scene, *accel, p.frame);
     p.all = p.work.primary;
     p.all += p.work.secondary;
+    const Cancellable cancellable;  // valgrind's runs and the JSON's write: nothing left behind
     p.counts = event_counts(scene, *accel, p.frame, o.scene, p.config, p.hardware);
 
     std::printf("rays                   %s primary + %s shadow = %s; native render %.4f s CPU (best of %d)\n",

@@ -197,6 +197,12 @@ Runner add_render(CLI::App& app) {
         // (cluster.hpp); rank 0 alone checks and writes the outputs.
         ShadingOptions shading;
         LocalStoreConfig local_store;
+        // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
+        const auto modelled_config = [&] {
+            AccelConfig config = o->accel.config();
+            if (o->accel.simd_option->count() == 0 && !o->accel.simd_named()) config.simd = "off";
+            return config;
+        };
         cluster::together([&] {
             shading = parse_shading_options(o->shading, o->ao_samples, *ao_samples);
             if (o->packet < 1 || o->packet > kMaxPacket)
@@ -212,7 +218,16 @@ Runner add_render(CLI::App& app) {
             } catch (const Error& e) {
                 throw option_error("--dispatch", e);
             }
-            if (!o->local_store.enabled) check_structure(o->accel);
+            if (o->local_store.enabled && o->accel.device != "cpu")
+                throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
+                            o->accel.device);
+            static const Triangle kOne{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+            if (o->local_store.enabled) {
+                check_names(o->accel);
+                make_local_store_accelerator(std::span<const Triangle>(&kOne, 1), modelled_config(), local_store);
+            } else {
+                check_structure(o->accel);
+            }
             if (cluster::leader()) {
                 check_output_file(o->out, o->overwrite);
                 if (!o->stats.empty()) check_output_file(o->stats, o->overwrite);
@@ -239,14 +254,8 @@ Runner add_render(CLI::App& app) {
             }
             ro.pin = o->pin;
             ro.cancel = &g_cancel;
-            if (o->local_store.enabled && o->accel.device != "cpu")
-                throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
-                            o->accel.device);
             if (o->local_store.enabled) {
-                // The model runs the single-ray kernels: SIMD packets are off unless asked for, and then refused.
-                AccelConfig config = o->accel.config();
-                if (o->accel.simd_option->count() == 0 && !o->accel.simd_named()) config.simd = "off";
-                modelled = make_local_store_accelerator(scene.triangles, config, local_store);
+                modelled = make_local_store_accelerator(scene.triangles, modelled_config(), local_store);
             } else {
                 direct = build_structure(scene.triangles, o->accel.config(), o->accel);
             }
@@ -267,8 +276,8 @@ Runner add_render(CLI::App& app) {
         progress.finish();
         if (!cluster::leader()) return 0;
         // Ctrl-C after the last packet, while the frame was gathered, still ends the run with no file
-        // (found by audit, 2026-12-07: it was ignored). One during the write itself is seen after it:
-        // the file is then whole.
+        // (found by audit, 2026-12-07: it was ignored). One during the writes is seen after them, by
+        // cellrt.cpp's run: the files are then whole, and the status 130.
         if (g_cancel) throw Error("render cancelled");
         if (const Image* image = std::get_if<Image>(&frame)) write_image(*image, o->out, o->overwrite);
         else write_png(std::get<Srgb8Image>(frame), o->out, o->overwrite);

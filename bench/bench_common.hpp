@@ -91,6 +91,9 @@ inline std::optional<std::string> scene_spec(const std::string& scenes_dir, cons
 // it lacks (+avx512 on a machine without it) is skipped with a message, not refused.
 inline bool simd_runs_here(const AccelConfig& c) {
     if (c.kind == "embree" || c.simd.empty() || c.simd == "off") return true;
+    // A name that is no set at all (`+avx3`) is the build's error to report, not a set to skip.
+    static const std::vector<std::string> kSets = {"auto", "portable", "sse", "avx2", "avx512"};
+    if (std::find(kSets.begin(), kSets.end(), c.simd) == kSets.end()) return true;
     try {
         detail::parse_isa(c.simd);
         return true;

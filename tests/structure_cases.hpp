@@ -121,7 +121,7 @@ inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_sce
     // Scenes whose lengths squared leave a float's range (traversal_margin's second branch), seen
     // along unit directions: at 1e20 the margin was inf / inf, NaN, and every structure culled the
     // whole scene; at 1e-17 the watertight test's T underflows, and its hits take t in double
-    // precision (triangle.hpp, ill_conditioned) within the margin's floor: every path must agree.
+    // precision (triangle.hpp, t_underflowed) within the margin's floor: every path must agree.
     // At 1e15 the determinant is a normal float (some 1e30) but T, a length cubed, overflows along
     // unit directions: t is +inf in front of the origin and -inf behind it, which the rays with
     // tnear = -inf (RaySuite::limited) would take but for the queries' finite bounds.

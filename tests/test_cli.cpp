@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -19,6 +20,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cellrt/image.hpp"
+#include "profile/callgrind.hpp"
+#include "sanitizers.hpp"
 
 extern char** environ;
 
@@ -100,6 +103,47 @@ TEST(Cli, InterruptedBuildEndsAtOnce) {
         const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         EXPECT_EQ(text, "cellrt: error: interrupted\n") << signal;
     }
+}
+
+// A signal while the outputs are written (here: the image is a FIFO no one reads yet) lets the write
+// finish whole, then ends the run with status 130 (found by review, 2026-12-07: status 0).
+TEST(Cli, InterruptedWriteEndsAsInterrupted) {
+    TempDir dir;
+    const fs::path fifo = dir.path / "frame.pfm", errors = dir.path / "errors.txt";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const pid_t pid = spawn({CELLRT_CLI, "render", "builtin:spheres?tris=200", "--size", "8x8", "-o", fifo.string()},
+                            errors.string());
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // blocked opening the FIFO
+    kill(pid, SIGTERM);
+    std::ifstream image(fifo, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(image)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(wait_exit(pid), 130);
+    EXPECT_EQ(bytes.size(), std::string("PF\n8 8\n-1.0\n").size() + 8 * 8 * 12) << "the image is written whole";
+    std::ifstream in(errors);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text, "cellrt: error: interrupted (the outputs were written whole)\n");
+}
+
+// A signalled profile kills its callgrind run and removes the run's folder (found by review,
+// 2026-12-07: valgrind ran on as an orphan, its folder left in the temporary directory).
+TEST(Cli, InterruptedProfileLeavesNoValgrindRun) {
+    if (profile::find_valgrind().empty()) GTEST_SKIP() << "valgrind not found on PATH";
+    CELLRT_SKIP_UNDER_SANITIZERS("valgrind cannot run the sanitized cellrt program");
+    TempDir dir;
+    ASSERT_EQ(::setenv("TMPDIR", dir.path.c_str(), 1), 0);  // the run's folder is made there
+    const pid_t pid = spawn({CELLRT_CLI, "profile", "builtin:city?tris=100000", "--method", "callgrind", "--size", "128x128"});
+    ::unsetenv("TMPDIR");
+    ASSERT_GT(pid, 0);
+    // Until the callgrind run's folder is there (the load, build and native renders come first).
+    const auto started = std::chrono::steady_clock::now();
+    while (fs::is_empty(dir.path) && std::chrono::steady_clock::now() - started < std::chrono::seconds(60))
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ASSERT_FALSE(fs::is_empty(dir.path)) << "no callgrind run was started";
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    kill(pid, SIGTERM);
+    EXPECT_EQ(wait_exit(pid), 130);
+    EXPECT_TRUE(fs::is_empty(dir.path)) << "the callgrind run's folder was left behind";
 }
 
 // Every path through the program gives the same bits, under every shading: structures, SIMD,
@@ -322,6 +366,8 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"render", "builtin:city?tris=5000000", "--accel", "bih:bogus", "-o", out},
          "--accel 'bih:bogus': bih has no traversal 'bogus' (it has: branched, branchless)"},
         {{"info", spheres, "--accel", ""}, "--accel: must not be empty (see --help)"},
+        {{"render", "builtin:city?tris=5000000", "--local-store", "--accel", "kd:bogus", "-o", out},
+         "--accel 'kd:bogus': kd has no traversal 'bogus' (it has: branched, rec, branchless)"},
         {{"info", folder_obj}, folder_obj + ": is a folder, not a file"},
         {{"info", dir.path.string()}, dir.path.string() + ": is a folder, not a file"},  // no extension
         {{"render", spheres, "-o", out, "--stats", out}, "--stats " + out + " names the same file as -o " + out},

@@ -172,7 +172,7 @@ INSTANTIATE_TEST_SUITE_P(Structures, SubnormalDirectionComponents, testing::Valu
 // squares are near 2^-104, still normal: every value small, nothing else. At 2^-46 with the
 // directions unscaled, t scales by 2^-46 and the test's T, a length cubed, is subnormal (the edge
 // functions stay normal); such hits are taken again in double precision (triangle.hpp,
-// ill_conditioned), so brute force finds the unscaled triangles at t within rounding of the scaled.
+// t_underflowed), so brute force finds the unscaled triangles at t within rounding of the scaled.
 class ScaledByPowersOfTwo : public testing::TestWithParam<std::string> {};
 
 TEST_P(ScaledByPowersOfTwo, SameHits) {

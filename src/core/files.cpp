@@ -116,9 +116,15 @@ void write_file_atomically(const std::string& path, std::string_view bytes, bool
     // Hidden, beside the target, named after it as far as a name's 255 bytes allow, and unique to
     // this process and call.
     static std::atomic<unsigned> calls{0};
+    // The target's name is cut so that the whole fits the folder's limit (eCryptfs allows 143 bytes,
+    // where a name check_output_file passed made a temporary name the system refused).
+    const std::string suffix = ".part" + std::to_string(::getpid()) + "-" + std::to_string(calls++);
+    const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+    std::size_t keep = 200;
+    if (name_max > 0) keep = std::min(keep, static_cast<std::size_t>(std::max(1L, name_max - 1 - static_cast<long>(suffix.size()))));
     std::string temp_name = ".";  // appended piece by piece: GCC 12 warns wrongly on "." + string (PR 105651)
-    temp_name += target.filename().string().substr(0, 200);
-    temp_name += ".part" + std::to_string(::getpid()) + "-" + std::to_string(calls++);
+    temp_name += target.filename().string().substr(0, keep);
+    temp_name += suffix;
     const fs::path temp = dir / temp_name;
     {
         std::ofstream out(temp, std::ios::binary | std::ios::trunc);

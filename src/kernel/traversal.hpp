@@ -39,7 +39,7 @@ CELLRT_HD inline float max_keep(float kept, float x) { return x > kept ? x : kep
 // where the whole scene lies within t < 2^-4 of the origin: for ordinary scenes and directions
 // the relative margin is larger (a 1e-17 scene along unit directions had garbage t of 0 that
 // brute force ranked first and the structures culled). Such hits now take t in double precision
-// (triangle.hpp, ill_conditioned); the floor still covers that t's rounding to float.
+// (triangle.hpp, t_underflowed); the floor still covers that t's rounding to float.
 inline constexpr float kMarginFloor = 0x1p-20f;
 
 // The margin in t: kMarginScale times the largest distance from the origin to the scene box

@@ -1,11 +1,13 @@
 #include "callgrind.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <charconv>
 #include <cstdint>
 #include <cstdlib>
@@ -14,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "cellrt/error.hpp"
 
@@ -62,7 +65,9 @@ std::string tail(const fs::path& file, int n) {
 }
 
 // Runs argv with stdin from /dev/null and stdout and stderr into `log`; returns the wait status.
-int spawn_and_wait(const std::vector<std::string>& args, const fs::path& log) {
+// Where `cancel` turns true the child is killed and reaped, and Error("cancelled") thrown: a
+// signalled profile left valgrind running and its folder behind (found by review, 2026-12-07).
+int spawn_and_wait(const std::vector<std::string>& args, const fs::path& log, const std::atomic<bool>* cancel) {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -76,9 +81,18 @@ int spawn_and_wait(const std::vector<std::string>& args, const fs::path& log) {
     posix_spawn_file_actions_destroy(&actions);
     if (err != 0) throw Error("cannot start " + args[0] + ": " + std::strerror(err));
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR) throw Error("waiting for " + args[0] + " failed: " + std::strerror(errno));
-    return status;
+    for (;;) {
+        const pid_t done = ::waitpid(pid, &status, cancel ? WNOHANG : 0);
+        if (done == pid) return status;
+        if (done < 0 && errno != EINTR) throw Error("waiting for " + args[0] + " failed: " + std::strerror(errno));
+        if (cancel && cancel->load()) {
+            ::kill(pid, SIGKILL);
+            while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+            }
+            throw Error("cancelled");
+        }
+        if (done == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
 }
 
 std::uint64_t parse_count(const std::string& word, const std::string& where) {
@@ -153,6 +167,9 @@ EventCounts run_callgrind(const std::vector<std::string>& command, const Callgri
                                      "--tool=callgrind",
                                      "--branch-sim=yes",
                                      "--cache-sim=no",
+                                     // No gdbserver pipes in the temporary directory: a run killed
+                                     // on cancel would leave them there.
+                                     "--vgdb=no",
                                      "--callgrind-out-file=" + out.string(),
                                      "--log-file=" + vg_log.string(),
                                      std::string("--instr-atstart=") + (options.instrument_at_start ? "yes" : "no"),
@@ -160,7 +177,7 @@ EventCounts run_callgrind(const std::vector<std::string>& command, const Callgri
     for (const std::string& f : options.toggle_collect) args.push_back("--toggle-collect=" + f);
     args.insert(args.end(), command.begin(), command.end());
 
-    const int status = spawn_and_wait(args, program_log);
+    const int status = spawn_and_wait(args, program_log, options.cancel);
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         const std::string how = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
                                                   : "signal " + std::to_string(WTERMSIG(status));

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <istream>
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct CallgrindOptions {
     // false: instrumentation starts off and the program turns it on around the region it wants
     // (start_instrumentation/stop_instrumentation), which also keeps the rest of it fast.
     bool instrument_at_start = true;
+    // Polled while valgrind runs: once true, the run is killed, its files removed, and run_callgrind
+    // throws cellrt::Error("cancelled"). Null: never cancelled.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 // valgrind's path if it is on PATH, else empty.

@@ -17,13 +17,21 @@ inline I det_in_range_lanes(F det) {
 }
 
 // The lanes `lanes` (bit i: lane i) of an ill-conditioned hit, refined one by one (refined_t), as
-// the scalar test refines its hit; a lane whose refined t is not finite is no hit. Out of line, so
-// that the rare case does not crowd the test's registers.
+// the scalar test refines its hit; a lane whose refined t is not finite is no hit. The lanes of
+// `tiny_only` were taken for a T of zero or subnormal alone: each is refined only where its terms
+// underflowed (t_underflowed, on the terms recomputed in the lane's order; the vector test keeps
+// them out of its registers). Out of line, so that the rare case does not crowd the test's registers.
 template <class Coord>
-[[gnu::noinline]] void refine_lanes(Coord coord, unsigned lanes, const F& ox, const F& oy, const F& oz, const F& sx,
-                                    const F& sy, const F& sz, F& t, F& u, F& v, I& hit) {
+[[gnu::noinline]] void refine_lanes(Coord coord, unsigned lanes, unsigned tiny_only, const F& eu, const F& ev,
+                                    const F& ew, const F& a_kz, const F& b_kz, const F& c_kz, const F& big_t,
+                                    const F& ox, const F& oy, const F& oz, const F& sx, const F& sy, const F& sz,
+                                    F& t, F& u, F& v, I& hit) {
     for (; lanes; lanes &= lanes - 1) {
         const int i = __builtin_ctz(lanes);
+        if ((tiny_only >> i) & 1) {
+            const float az = sz[i] * a_kz[i], bz = sz[i] * b_kz[i], cz = sz[i] * c_kz[i];
+            if (!t_underflowed(big_t[i], eu[i] * az, ev[i] * bz, ew[i] * cz)) continue;
+        }
         float x[3], y[3], z[3];
         for (int k = 0; k < 3; ++k) {
             x[k] = coord(k, 0)[i];
@@ -74,8 +82,7 @@ template <class Coord>
     const I positive = (eu > 0.f) | (ev > 0.f) | (ew > 0.f);
     const F det = eu + ev + ew;
     const F az = sz * a_kz, bz = sz * b_kz, cz = sz * c_kz;
-    const F t0 = eu * az, t1 = ev * bz, t2 = ew * cz;
-    const F big_t = t0 + t1 + t2;
+    const F big_t = eu * az + ev * bz + ew * cz;
     const F inv_det = splat(1.f) / det;
     t = big_t * inv_det;
     u = ev * inv_det;
@@ -88,15 +95,12 @@ template <class Coord>
         const F lateral = lane_max_f(lane_max_f(lane_max_f(abs_lanes(ax), abs_lanes(bx)), abs_lanes(cx)),
                                      lane_max_f(lane_max_f(abs_lanes(ay), abs_lanes(by)), abs_lanes(cy)));
         const F depth = lane_max_f(lane_max_f(a_kz, b_kz), c_kz) - lane_min_f(lane_min_f(a_kz, b_kz), c_kz);
-        I ill = hit & (abs_lanes(t) < splat(kInfinity)) &
-                ((lateral * depth) * splat(1.f / kIllConditioned) > abs_lanes(det));
-        // T lost to underflow (triangle.hpp, t_underflowed): its terms read only where T is tiny.
-        const F least = splat(kLeastNormal);
-        if (const I tiny = hit & (abs_lanes(big_t) < least); any(tiny)) [[unlikely]]
-            ill |= tiny & (abs_lanes(t) < splat(kInfinity)) &
-                   (lane_max_f(lane_max_f(abs_lanes(t0), abs_lanes(t1)), abs_lanes(t2)) < least);
+        const I ratio = (lateral * depth) * splat(1.f / kIllConditioned) > abs_lanes(det);
+        // A T of zero or subnormal (triangle.hpp, t_underflowed): its terms are looked at out of line.
+        const I ill = hit & (abs_lanes(t) < splat(kInfinity)) & (ratio | (abs_lanes(big_t) < splat(kLeastNormal)));
         if (const unsigned lanes = bits(ill)) [[unlikely]]
-            refine_lanes(coord, lanes, ox, oy, oz, sx, sy, sz, t, u, v, hit);
+            refine_lanes(coord, lanes, bits(ill & ~ratio), eu, ev, ew, a_kz, b_kz, c_kz, big_t, ox, oy, oz, sx, sy, sz,
+                         t, u, v, hit);
     }
     return hit;
 }
