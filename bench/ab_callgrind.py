@@ -23,7 +23,7 @@ With --cache-sim, callgrind also simulates the data caches (Zen 3's: 32 KiB firs
 second) and the table adds the first- and second-level data misses per ray of the same calls: the
 lines a traversal touches that were not cached, which instruction counts do not see.
 
-    bench/ab_callgrind.py OLD NEW --json out.json [--keep DIR] [--cache-sim] -- [cellrt_bench options]
+    bench/ab_callgrind.py OLD NEW --json out.json [--overwrite] [--keep DIR] [--cache-sim] -- [cellrt_bench options]
 """
 import argparse
 import glob
@@ -34,6 +34,8 @@ import re
 import subprocess
 import sys
 import tempfile
+
+from bench_outputs import check_output
 
 ENTRY = re.compile(r"^[\w:<>, ]*::(intersect|occluded)\(std::span<cellrt::Ray const")
 
@@ -171,6 +173,7 @@ def main():
     ap.add_argument("old")
     ap.add_argument("new")
     ap.add_argument("--json", required=True, help="write the counts and ratios here")
+    ap.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
     ap.add_argument("--keep", help="keep the callgrind dumps in folders under this one")
     ap.add_argument("--cache-sim", action="store_true",
                     help="also simulate the caches (32 KiB L1, 512 KiB L2) and report first- and second-level "
@@ -180,6 +183,7 @@ def main():
     argv = sys.argv[1:]
     split = argv.index("--") if "--" in argv else len(argv)
     o = ap.parse_args(argv[:split])
+    check_output(ap, "--json", o.json, o.overwrite)
     args = argv[split + 1:]
     configs = option_values(args, "--configs", ["kd:rec", "kd:branched", "kd:branchless", "kd+auto",
                                                 "bih:branched", "bih:branchless", "bih+auto", "bih+auto@split=sah"])

@@ -16,6 +16,8 @@ import subprocess
 import sys
 import tempfile
 
+from bench_outputs import check_output
+
 
 def run(binary, args):
     # A path that does not exist yet: cellrt_bench refuses to replace a file without --overwrite,
@@ -44,13 +46,7 @@ def main():
     if o.rounds < 1:
         ap.error(f"--rounds {o.rounds}: must be 1 or more")
     if o.json:
-        folder = os.path.dirname(os.path.abspath(o.json))
-        if not os.path.isdir(folder):
-            ap.error(f"--json {o.json}: no folder {folder} to write it in")
-        if os.path.isdir(o.json):
-            ap.error(f"--json {o.json}: is a folder")
-        if os.path.exists(o.json) and not o.overwrite:
-            ap.error(f"--json {o.json}: file exists (pass --overwrite to replace it)")
+        check_output(ap, "--json", o.json, o.overwrite)
     times = {"a": {}, "b": {}}
     runs = []
     for r in range(o.rounds):

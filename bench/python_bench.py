@@ -69,18 +69,6 @@ def checked(parser, args, default_kind=False):
     return args
 
 
-def check_output(parser, option, path, overwrite):
-    """Refuses, before any work, an output `path` whose folder is not there, or a file there already
-    without --overwrite (cellrt_bench's rules and words)."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        parser.error(f"{option} {path}: no folder {folder} to write it in")
-    if os.path.isdir(path):
-        parser.error(f"{option} {path}: is a folder")
-    if os.path.exists(path) and not overwrite:
-        parser.error(f"{option} {path}: file exists (pass --overwrite to replace it)")
-
-
 def main():
     parser = arguments(__doc__, "kd,bvh", 9, 0, 1024)
     parser.add_argument("--clock", choices=["wall", "cpu"], default="wall",

@@ -18,7 +18,8 @@ import statistics
 import time
 
 import cellrt
-from python_bench import arguments, check_output, checked, incoherent_rays
+from bench_outputs import check_output
+from python_bench import arguments, checked, incoherent_rays
 
 
 def main():

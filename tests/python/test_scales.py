@@ -66,3 +66,22 @@ def test_scaled_scene_origins_and_directions(probe, scale):
     # functions overflow and every path misses alike.
     if scale <= 1e18:
         assert (ref["prim"] >= 0).sum() > len(org) // 10
+
+
+@pytest.mark.parametrize("scale,direction_scale", [(1e-12, 1e8), (1e-16, 1.0), (1e-17, 1.0)])
+def test_tiny_scene_along_long_or_unit_directions(probe, scale, direction_scale):
+    """The scene and origins shrunk, the directions not (or lengthened): the test's T, a length cubed,
+    underflows. Its sign was lost, and triangles behind an origin were hit at t = -0 before the one in
+    front: 1,365 of 20,000 rays into a 1e-12 soup along directions 1e8 long took a wrong triangle
+    (found by audit, 2026-12-07). Such hits take t in double precision (triangle.hpp, t_underflowed):
+    the unscaled triangles, every path alike."""
+    tris, org, dirs = probe
+    s = np.float32(scale)
+    ref, bad = disagreements((tris * s).astype(np.float32), (org * s).astype(np.float32),
+                             (dirs * np.float32(direction_scale)).astype(np.float32))
+    assert not bad, bad
+    unscaled = cellrt.Accelerator(tris, kind="brute", simd="off").intersect(org, dirs)
+    assert (unscaled["prim"] >= 0).sum() > len(org) // 10
+    # The same triangles but where two lie within rounding of one depth (a shared edge's neighbours).
+    assert (ref["prim"] != unscaled["prim"]).sum() <= len(org) // 500
+    assert (ref["t"][ref["prim"] >= 0] >= 0).all(), "a hit behind its origin"

@@ -52,7 +52,7 @@ fi
 # in_place/: the kd-tree's (and BIH's) packets made in place in trace_batch (B_IN_PLACE) against the
 # build before it (B_BEFORE_IN_PLACE): instructions (callgrind, AVX2 under valgrind) and two timed runs.
 if [ -n "$B_IN_PLACE" ]; then
-  python3 bench/ab_callgrind.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --json $D/in_place/callgrind_frame.json -- \
+  python3 bench/ab_callgrind.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --overwrite --json $D/in_place/callgrind_frame.json -- \
     --scenes-dir ../shared/scenes --scenes sponza bunny --configs kd+auto --rays frame --size 128x128 --repeats 1 --builds 1
   python3 bench/ab_compare.py "$B_BEFORE_IN_PLACE" "$B_IN_PLACE" --overwrite --rounds 3 --json $D/in_place/time_frame_1.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot --configs embree:packet16 kd+auto bih+auto \
@@ -75,9 +75,9 @@ mkdir -p $D/state_head && bench/incoherent_state.sh $D/state_head && python3 doc
 # leaf_lanes/: the packets' leaves tested in the rays' lanes (B_LL, 'as many rays as triangles') against
 # the build before it (B_BEFORE_LL); B_LL2 the same with 'twice as many':
 if [ -n "$B_LL" ]; then
-  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --json $D/leaf_lanes/callgrind_frame.json -- \
+  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --overwrite --json $D/leaf_lanes/callgrind_frame.json -- \
     --scenes-dir ../shared/scenes --scenes sponza bunny --configs bvh:packet --rays frame --size 128x128 --repeats 1 --builds 1
-  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --json $D/leaf_lanes/callgrind_ao.json -- \
+  python3 bench/ab_callgrind.py "$B_BEFORE_LL" "$B_LL" --overwrite --json $D/leaf_lanes/callgrind_ao.json -- \
     --scenes-dir ../shared/scenes --scenes sponza sibenik --configs bvh:packet --rays ao --size 128x128 --repeats 1 --builds 1
   for k in frame ao diffuse; do
     python3 bench/ab_compare.py "$B_BEFORE_LL" "$B_LL" --overwrite --rounds 3 --json $D/leaf_lanes/time_$k.json -- \
@@ -99,8 +99,8 @@ for s in ao diffuse; do
 done
 python3 $D/two_workers/table.py $D/two_workers_final > $D/two_workers_final/table.md
 # leaf_lanes/callgrind_half_vs_kept.json: the lanes from half as many rays as triangles (B_LL_HALF):
-[ -n "$B_LL_HALF" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_LL_HALF" --json $D/leaf_lanes/callgrind_half_vs_kept.json -- \
+[ -n "$B_LL_HALF" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_LL_HALF" --overwrite --json $D/leaf_lanes/callgrind_half_vs_kept.json -- \
   --scenes-dir ../shared/scenes --scenes sponza bunny --configs bvh:packet --rays frame --size 128x128 --repeats 1 --builds 1
 # leaf_lanes/callgrind_one_copy.json: one copy of the watertight test in lanes (B_ONE_COPY) against B_LL:
-[ -n "$B_ONE_COPY" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_ONE_COPY" --json $D/leaf_lanes/callgrind_one_copy.json -- \
+[ -n "$B_ONE_COPY" ] && python3 bench/ab_callgrind.py "$B_LL" "$B_ONE_COPY" --overwrite --json $D/leaf_lanes/callgrind_one_copy.json -- \
   --scenes-dir ../shared/scenes --scenes sponza --configs bvh:packet bvh kd+auto --rays frame --size 128x128 --repeats 1 --builds 1

@@ -17,7 +17,7 @@ for kind in random diffuse; do
     --configs embree:single embree:packet8 bvh auto
 done
 # 2. Instructions and simulated misses of the BVH's single rays.
-python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --cache-sim \
+python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --cache-sim --overwrite \
   --json $out/callgrind_random.json -- --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
   --configs bvh --size 128x128 --builds 1 --repeats 1 --rays random
 python3 $out/summary.py $out/ab_random.json $out/ab_diffuse.json $out/ab_frame.json $out/ab512_random.json $out/ab512_diffuse.json

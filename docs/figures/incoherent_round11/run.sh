@@ -27,7 +27,7 @@ done
 python3 $out/summary.py $out/ab_auto_random.json $out/ab_auto_ao.json $out/ab_auto_diffuse.json $out/ab_auto_frame.json
 # 4. Instructions (callgrind; AVX2 under valgrind): the one-ray kernel old against new, and in the
 #    new binary one ray against two (the file's "old" and "new" are then the same binary).
-python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --json $out/callgrind_single.json -- \
+python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --json $out/callgrind_single.json -- \
   $S --scenes sponza --configs bvh bvh:paired --size 64x64 --builds 1 --repeats 1 --rays random
-python3 bench/ab_callgrind.py $NEW/bench/cellrt_bench $NEW/bench/cellrt_bench --json $out/callgrind_paired.json -- \
+python3 bench/ab_callgrind.py $NEW/bench/cellrt_bench $NEW/bench/cellrt_bench --overwrite --json $out/callgrind_paired.json -- \
   $S --scenes sponza --configs bvh bvh:paired --size 64x64 --builds 1 --repeats 1 --rays random

@@ -7,7 +7,7 @@ NEW=$NEW $out/run_same_binary.sh
 python3 $out/summary_same.py
 # 2. Instructions and simulated misses of the BVH's kernels, old binary against new.
 for kind in random ao; do
-  python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --cache-sim \
+  python3 bench/ab_callgrind.py $OLD/bench/cellrt_bench $NEW/bench/cellrt_bench --cache-sim --overwrite \
     --json $out/callgrind_$kind.json -- --scenes-dir ../shared/scenes --scenes sponza sibenik bunny teapot \
     --configs bvh bvh:packet --size 128x128 --builds 1 --repeats 1 --rays $kind
 done

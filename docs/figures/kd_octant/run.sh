@@ -16,6 +16,6 @@ done
 # Speed over rtcIntersect1 / rtcOccluded1 in the same runs, old (a) and new (b):
 for side in a b; do python3 $D/ratios.py $D/ab_frame.json $side > $D/ratios_frame_$side.txt; done
 # Instructions of one timed pass (deterministic):
-python3 bench/ab_callgrind.py $OLD $NEW --json $D/callgrind_frame.json -- --scenes-dir ../shared/scenes --scenes sponza bunny \
+python3 bench/ab_callgrind.py $OLD $NEW --overwrite --json $D/callgrind_frame.json -- --scenes-dir ../shared/scenes --scenes sponza bunny \
   --size 128x128 --repeats 1 --builds 1 --rays frame --configs kd:rec kd:branched kd:branchless bih:branched \
   | grep '^|' > $D/callgrind_frame.md
