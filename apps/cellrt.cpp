@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "cellrt/error.hpp"
+#include "cellrt/version.hpp"
 #include "cli.hpp"
 #include "cluster.hpp"
 
@@ -29,6 +30,7 @@ int run(int argc, char** argv) {
     CLI::App app{"cellrt: kd-tree and BIH ray tracing kernels after 'Data structures for ray tracing on Cell "
                  "architecture' (M. Hapala)"};
     app.require_subcommand(0, 1);
+    app.set_version_flag("--version", std::string(cli::cluster::program()) + " " + CELLRT_VERSION_STRING);
     // The first command is the default: `cellrt` alone renders the default scene.
     const std::vector<cli::Runner> runners = {cli::add_render(app), cli::add_info(app), cli::add_profile(app),
                                               cli::add_cache_study(app)};

@@ -70,7 +70,9 @@ void check_no_repeats(const std::string& option, const std::vector<T>& values) {
 inline int flushed(int status) {
     if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return status;
     if (leader()) std::fprintf(stderr, "%s: error: standard output: write failed\n", program());
-    return status == 0 ? 1 : status;
+    // The error the run ends with, whatever it had to say (`info --device cuda > /dev/full` kept the
+    // no-device status 3, its line lost; found by audit, 2026-12-07), but an interrupt's 130.
+    return status == 130 ? status : 1;
 }
 
 // Integer options read as decimal digits only (no sign, no leading zero), and numbers as

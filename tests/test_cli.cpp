@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cellrt/image.hpp"
+#include "cellrt/version.hpp"
 #include "profile/callgrind.hpp"
 #include "sanitizers.hpp"
 
@@ -144,6 +146,17 @@ TEST(Cli, InterruptedProfileLeavesNoValgrindRun) {
     kill(pid, SIGTERM);
     EXPECT_EQ(wait_exit(pid), 130);
     EXPECT_TRUE(fs::is_empty(dir.path)) << "the callgrind run's folder was left behind";
+}
+
+// The version a bug report quotes, as the library's header gives it.
+TEST(Cli, VersionIsTheLibrarys) {
+    std::FILE* p = ::popen((std::string(CELLRT_CLI) + " --version").c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    char line[128] = {};
+    const bool read = std::fgets(line, sizeof line, p) != nullptr;
+    EXPECT_EQ(::pclose(p), 0);
+    ASSERT_TRUE(read);
+    EXPECT_EQ(std::string(line), std::string("cellrt ") + CELLRT_VERSION_STRING + "\n");
 }
 
 // Every path through the program gives the same bits, under every shading: structures, SIMD,
@@ -461,12 +474,13 @@ TEST(Cli, AnErrorOnARenderWorkerIsTheProgramsError) {
 }
 
 // A report printed into a full disk is lost: `cellrt info` into /dev/full ended with status 0 (found by
-// review, 2026-12-06); now it says so and ends with 1.
+// review, 2026-12-06); now it says so and ends with 1, also where the run had another status to give
+// (`info --device cuda`, 3 where there is no GPU: found by audit, 2026-12-07).
 TEST(Cli, OutputThatCannotBeWrittenIsAnError) {
     if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
     TempDir dir;
     const std::string errors = (dir.path / "errors.txt").string();
-    for (const std::string args : {"info 'builtin:city?tris=300'", "info --params kd"}) {
+    for (const std::string args : {"info 'builtin:city?tris=300'", "info --params kd", "info --device cuda", "--version"}) {
         const int status = std::system((std::string(CELLRT_CLI) + " " + args + " > /dev/full 2> " + errors).c_str());
         ASSERT_TRUE(WIFEXITED(status)) << args;
         EXPECT_EQ(WEXITSTATUS(status), 1) << args;
