@@ -173,6 +173,9 @@ RenderOptions profiled_frame(const Scene& scene, const ProfileOptions& o, bool h
     if (!o.size.empty()) std::tie(ro.width, ro.height) = parse_image_size("--size", o.size);
     ro.threads = 1;
     ro.packet = o.packet;
+    // The frames counted with the processor's counters run in a Cancellable section (run_profile):
+    // they stop at the next packet on a signal.
+    ro.cancel = &g_cancel;
     return ro;
 }
 
