@@ -21,7 +21,9 @@ extern "C" void on_interrupt(int) {
     cellrt::cli::g_cancel.store(true);
     if (cellrt::cli::g_cancellable.load()) return;
     static const char message[] = "cellrt: error: interrupted\n";
-    if (g_say_interrupted) [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, message, sizeof message - 1);
+    if (g_say_interrupted) {
+        [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, message, sizeof message - 1);
+    }
     _exit(130);
 }
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <unistd.h>
 
+#include "kernel/named.hpp"
 #include "localstore/local_store.hpp"
 #include "simd/isa.hpp"
 #include "cellrt/builtin.hpp"
@@ -143,29 +144,22 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
 
 AccelConfig check_names(const AccelOptions& options) {
     const AccelConfig config = options.config();
-    // The library's words for an unknown kind or traversal, behind the option that gave it.
-    const std::vector<std::string> kinds = accelerator_kinds();
-    if (std::find(kinds.begin(), kinds.end(), config.kind) == kinds.end()) {
-        try {
-            accelerator_traversals(config.kind);
-        } catch (const Error& e) {
-            throw Error("--accel '" + options.kind + "': " + e.what());
-        }
+    // The library's words for an unknown kind, behind the option that gave it.
+    const std::vector<std::string>* traversals = nullptr;
+    try {
+        traversals = &accelerator_traversals(config.kind);
+    } catch (const Error& e) {
+        throw Error("--accel '" + options.kind + "': " + e.what());
     }
-    const std::vector<std::string>& traversals = accelerator_traversals(config.kind);
-    if (!config.traversal.empty() && std::find(traversals.begin(), traversals.end(), config.traversal) == traversals.end()) {
-        std::string offered;
-        for (const std::string& t : traversals) offered += (offered.empty() ? "" : ", ") + t;
+    if (!config.traversal.empty() && std::find(traversals->begin(), traversals->end(), config.traversal) == traversals->end())
         throw Error((options.traversal.empty() ? "--accel '" + options.kind + "'" : "--traversal '" + options.traversal + "'") +
-                    ": " + config.kind + " has no traversal '" + config.traversal + "' (it has: " + offered + ")");
-    }
+                    ": " + config.kind + " has no traversal '" + config.traversal + "' (it has: " +
+                    detail::join_names(*traversals) + ")");
     return config;
 }
 
 void check_structure(const AccelOptions& options) {
-    const AccelConfig config = check_names(options);
-    static const Triangle kOne{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
-    build_structure(std::span<const Triangle>(&kOne, 1), config, options);
+    build_structure(std::span<const Triangle>(&kOneTriangle, 1), check_names(options), options);
 }
 
 void check_threads(unsigned threads) {

@@ -82,6 +82,9 @@ std::unique_ptr<Accelerator> build_structure(std::span<const Triangle> triangles
 // `info` printed half its report), in the words of the option that gave it.
 void check_structure(const AccelOptions& options);
 
+// The scene check_structure builds over: a structure's options are refused by it as by any scene's.
+inline constexpr Triangle kOneTriangle{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+
 // options.config(), its kind and traversal checked against the library's and refused in the words of
 // the option that gave them (what check_structure does before it builds).
 AccelConfig check_names(const AccelOptions& options);

@@ -221,10 +221,9 @@ Runner add_render(CLI::App& app) {
             if (o->local_store.enabled && o->accel.device != "cpu")
                 throw Error("--local-store models the Cell's local store on the CPU; it does not run with --device " +
                             o->accel.device);
-            static const Triangle kOne{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
             if (o->local_store.enabled) {
                 check_names(o->accel);
-                make_local_store_accelerator(std::span<const Triangle>(&kOne, 1), modelled_config(), local_store);
+                make_local_store_accelerator(std::span<const Triangle>(&kOneTriangle, 1), modelled_config(), local_store);
             } else {
                 check_structure(o->accel);
             }

@@ -79,10 +79,13 @@ ParsedSpec parse_spec(const std::string& spec) {
     bool tris_given = false, seed_given = false;
     // After a '?', pairs separated by '&', none empty: "?" alone and a trailing '&' are refused as
     // "&&" is (found by audit, 2026-12-07: they were accepted).
-    for (std::string_view query = q == std::string_view::npos ? std::string_view{} : rest.substr(q + 1);
-         q != std::string_view::npos;) {
+    if (q == std::string_view::npos) return {gen, params};
+    std::string_view query = rest.substr(q + 1);
+    for (bool last = false; !last;) {
         const std::size_t amp = query.find('&');
+        last = amp == std::string_view::npos;
         const std::string_view pair = query.substr(0, amp);
+        query.remove_prefix(last ? query.size() : amp + 1);
         const std::size_t eq = pair.find('=');
         if (eq == std::string_view::npos) throw Error(spec + ": expected key=value, got '" + std::string(pair) + "'");
         const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
@@ -95,8 +98,6 @@ ParsedSpec parse_spec(const std::string& spec) {
         } else {
             throw Error(spec + ": unknown key '" + std::string(key) + "' (known: tris, seed)");
         }
-        if (amp == std::string_view::npos) break;
-        query.remove_prefix(amp + 1);
     }
     return {gen, params};
 }
