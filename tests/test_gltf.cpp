@@ -333,6 +333,10 @@ TEST_F(GltfTest, BadFilesAreRefusedNamingThePartAtFault) {
     cam["nodes"][0]["scale"] = {0, 0, 0};
     EXPECT_EQ(error(cam), "node 0: its transform leaves camera 0 without a view direction and an up vector");
     EXPECT_EQ(error(with("/nodes/0/camera", 2)), "node 0: camera 2 does not exist (the file has 0 cameras)");
+    // Below pi as a double, 180 degrees as the camera's float (found by audit, 2026-12-07).
+    json wide = with("/nodes/0/camera", 0);
+    wide["cameras"] = json::parse(R"([{"type": "perspective", "perspective": {"yfov": 3.141592653589, "znear": 0.1}}])");
+    EXPECT_EQ(error(wide), "camera 0: yfov must lie in (0, pi) radians, and in (0, 180) degrees as a float");
 
     // tinygltf's own refusals: JSON, a missing buffer file, a truncated .glb.
     const std::string bad_json = write("bad.gltf", "{\"asset\": ");

@@ -719,7 +719,20 @@ TEST_F(LoaderTest, ViewFileNumbersBeyondTheirRangeAreNamed) {
          ": field 'image.width' must be an integer in [1, 65536]"},
         {"\"width\": 64", "\"width\": 18446744073709551615", ": field 'image.width' must be an integer in [1, 65536]"},
         {"\"width\": 64", "\"width\": -9223372036854775809", ": field 'image.width' must be an integer in [1, 65536]"},
-        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e-400", ": camera fov_y_deg = 0.000000 must lie in (0, 180)"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e-400",
+         ": field 'camera.fov_y_deg' is 0.0; it must lie in (0, 180) degrees"},
+        // Found by audit (2026-12-07): in (0, 180) as doubles, 0 and 180 as the camera's floats,
+        // reported as "fov_y_deg = 180.000000 must lie in (0, 180)".
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 179.99999999999",
+         ": field 'camera.fov_y_deg' is 179.99999999999, which rounds to 180.0 as a float; it must lie "
+         "in (0, 180) degrees"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": 1e-50",
+         ": field 'camera.fov_y_deg' is 1e-50, which rounds to 0.0 as a float; it must lie in (0, 180) "
+         "degrees"},
+        // Beyond a float: an infinity that the light refused without naming the field.
+        {"0.25", "1e39", ": field 'light.color[2]' is 1e+39, beyond a float's range (about 3.4e38)"},
+        {"\"fov_y_deg\": 45", "\"fov_y_deg\": -1e39",
+         ": field 'camera.fov_y_deg' is -1e+39, beyond a float's range (about 3.4e38)"},
     };
     for (const Case& c : cases) {
         std::string text = doc;
@@ -811,8 +824,8 @@ TEST_F(LoaderTest, ViewFileRejectsWrongTypes) {
         {[](json& d) { d["image"]["width"] = 0; }, "field 'image.width' must be an integer in [1, 65536]"},
         {[](json& d) { d["image"]["height"] = 12.5; }, "field 'image.height' must be an integer in [1, 65536]"},
         // Finite doubles beyond float's range: infinite once read as floats.
-        {[](json& d) { d["light"]["position"] = {0, 1e39, 0}; }, "the light position is not finite"},
-        {[](json& d) { d["light"]["color"] = {1e39, 1, 1}; }, "the light color is not finite"},
+        {[](json& d) { d["light"]["position"] = {0, 1e39, 0}; }, "field 'light.position[1]' is 1e+39, beyond a float's range (about 3.4e38)"},
+        {[](json& d) { d["light"]["color"] = {1e39, 1, 1}; }, "field 'light.color[0]' is 1e+39, beyond a float's range (about 3.4e38)"},
         // Found by audit (2026-12-07): accepted, a name of the wrong type replaced by the file's, and
         // a negative colour shading pixels below zero.
         {[](json& d) { d["light"]["color"] = {1, -1, 1}; }, "the light color has a negative channel"},
@@ -860,11 +873,11 @@ TEST_F(LoaderTest, ViewFileRejectsImpossibleCameras) {
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1e25, 0}}, {"fov_y_deg", 45}},
          "camera up's length is 1e+25: float arithmetic takes lengths from about 4e-23 to 1.8e19"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 0}},
-         "camera fov_y_deg = 0.000000 must lie in (0, 180)"},
+         "field 'camera.fov_y_deg' is 0; it must lie in (0, 180) degrees"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", 180}},
-         "camera fov_y_deg = 180.000000 must lie in (0, 180)"},
+         "field 'camera.fov_y_deg' is 180; it must lie in (0, 180) degrees"},
         {{{"position", {0, 0, 3}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov_y_deg", -30}},
-         "camera fov_y_deg = -30.000000 must lie in (0, 180)"},
+         "field 'camera.fov_y_deg' is -30; it must lie in (0, 180) degrees"},
     };
     for (const Case& c : cases) {
         json doc = view_doc();

@@ -14,8 +14,11 @@ PinholeCamera::PinholeCamera(const Camera& camera, int width, int height) {
     check_image_size(width, height);
     if (!is_finite(camera.position) || !is_finite(camera.look_at) || !is_finite(camera.up))
         throw Error("camera position, look_at and up must be finite");
-    if (!(camera.fov_y_deg > 0.f && camera.fov_y_deg < 180.f))
-        throw Error("camera fov_y_deg = " + std::to_string(camera.fov_y_deg) + " must lie in (0, 180)");
+    if (!(camera.fov_y_deg > 0.f && camera.fov_y_deg < 180.f)) {
+        char text[96];
+        std::snprintf(text, sizeof text, "camera fov_y_deg = %.9g must lie in (0, 180)", double{camera.fov_y_deg});
+        throw Error(text);
+    }
     // Lengths are taken in float, where the square of a length overflows from about 1.8e19 and
     // underflows to zero below about 4e-23: such a view direction or up could not be normalised, and
     // was reported as "up is parallel to the view direction" or as a zero length it did not have.

@@ -302,7 +302,11 @@ private:
         if (camera_ || c.type != "perspective") return;
         const std::string name = named("camera", static_cast<std::size_t>(index), c.name);
         const double yfov = c.perspective.yfov;
-        if (!(yfov > 0.0 && yfov < std::numbers::pi)) fail(name + ": yfov must lie in (0, pi) radians");
+        // Checked in degrees as the float the camera gets: a yfov a few ulps below pi or above 0
+        // rounds to 180 or 0 there.
+        const float fov_y_deg = static_cast<float>(yfov * 180.0 / std::numbers::pi);
+        if (!(yfov > 0.0 && fov_y_deg > 0.f && fov_y_deg < 180.f))
+            fail(name + ": yfov must lie in (0, pi) radians, and in (0, 180) degrees as a float");
         const double aspect = c.perspective.aspectRatio;
         if (!(aspect >= 0.0) || !std::isfinite(aspect)) fail(name + ": aspectRatio must be a positive number");
         // A glTF camera looks down its node's -z with +y up.
@@ -314,7 +318,7 @@ private:
             fail(node_name(node) + ": its transform leaves " + name + " without a view direction and an up vector");
         cam.look_at = cam.position + normalize(forward);
         cam.up = normalize(up);
-        cam.fov_y_deg = static_cast<float>(yfov * 180.0 / std::numbers::pi);
+        cam.fov_y_deg = fov_y_deg;
         camera_ = cam;
         if (aspect > 0.0) aspect_ = static_cast<float>(aspect);
     }

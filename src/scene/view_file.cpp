@@ -1,6 +1,8 @@
 // View files: JSON with mesh, camera, light and image (shared/scenes/README.md).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -93,12 +95,20 @@ public:
         return v;
     }
 
+    // Every field is kept as a float: a number beyond float's range became an infinity that the
+    // camera or the light refused without naming the field.
+    float single(const json& j, const std::string& name) const {
+        const double v = number(j, name);
+        if (std::fabs(v) > std::numeric_limits<float>::max())
+            fail(name, "is " + j.dump() + ", beyond a float's range (about 3.4e38)");
+        return static_cast<float>(v);
+    }
+
     Vec3 vec3(const json& parent, const std::string& parent_name, const char* key) const {
         const std::string name = parent_name + "." + key;
         const json& j = field(parent, parent_name, key);
         if (!j.is_array() || j.size() != 3) fail(name, "must be an array of three numbers");
-        return {static_cast<float>(number(j[0], name + "[0]")), static_cast<float>(number(j[1], name + "[1]")),
-                static_cast<float>(number(j[2], name + "[2]"))};
+        return {single(j[0], name + "[0]"), single(j[1], name + "[1]"), single(j[2], name + "[2]")};
     }
 
     // Refuses a key the format does not have: a misspelt optional field ("colour") would otherwise
@@ -183,7 +193,16 @@ public:
         scene.camera.position = vec3(cam, "camera", "position");
         scene.camera.look_at = vec3(cam, "camera", "look_at");
         scene.camera.up = vec3(cam, "camera", "up");
-        scene.camera.fov_y_deg = static_cast<float>(number(field(cam, "camera", "fov_y_deg"), "camera.fov_y_deg"));
+        const json& fov = field(cam, "camera", "fov_y_deg");
+        scene.camera.fov_y_deg = single(fov, "camera.fov_y_deg");
+        // Checked as the float the camera gets: 179.99999999999 rounds to 180 and 1e-50 to 0.
+        if (!(scene.camera.fov_y_deg > 0.f && scene.camera.fov_y_deg < 180.f)) {
+            const double given = fov.get<double>();
+            const std::string rounded = given > 0.0 && given < 180.0
+                                            ? ", which rounds to " + json(scene.camera.fov_y_deg).dump() + " as a float"
+                                            : "";
+            fail("camera.fov_y_deg", "is " + fov.dump() + rounded + "; it must lie in (0, 180) degrees");
+        }
 
         const json& light = object(doc, "light");
         only(light, "light", {"type", "position", "color"});
