@@ -39,6 +39,7 @@
 #include "cellrt/device.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/loaders.hpp"
+#include "core/csv.hpp"
 #include "core/files.hpp"
 #include "cellrt/render.hpp"
 #include "cellrt/scene.hpp"
@@ -249,11 +250,11 @@ std::string csv_row(const std::string& scene, const Run& run, const Result& r, s
         if (c.hits + c.misses > 0) std::snprintf(text, sizeof text, "%.6f", c.hit_ratio());
         return std::string(text);
     };
-    char buf[1024];
+    char buf[1024];  // the fields after the scene's name, which is the user's and of any length
     std::snprintf(buf, sizeof buf,
-                  "%s,%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%s,%llu,%llu,"
+                  "%s,%s,%s,%s,%s,%u,%u,%u,%s,%u,%u,%u,%llu,%llu,%llu,%s,%llu,%llu,%llu,%llu,%llu,%s,%llu,%llu,"
                   "%llu,%llu,%.3f,%.4f,%.4f\n",
-                  scene.c_str(), run.structure.c_str(), run.traversal.c_str(), to_string(c.access), run.sweep.c_str(),
+                  run.structure.c_str(), run.traversal.c_str(), to_string(c.access), run.sweep.c_str(),
                   c.node_cache.to_string().c_str(), c.node_cache.line_bytes, c.node_cache.sets, c.node_cache.ways,
                   c.triangle_cache.to_string().c_str(), c.triangle_cache.line_bytes, c.triangle_cache.sets,
                   c.triangle_cache.ways, static_cast<unsigned long long>(s.rays),
@@ -263,7 +264,7 @@ std::string csv_row(const std::string& scene, const Run& run, const Result& r, s
                   static_cast<unsigned long long>(t.misses), ratio(t).c_str(), static_cast<unsigned long long>(t.bytes),
                   static_cast<unsigned long long>(t.evictions), static_cast<unsigned long long>(s.cycles),
                   static_cast<unsigned long long>(s.stall_cycles), s.cycles_per_ray(), frame_ms, r.wall_seconds);
-    return buf;
+    return detail::csv_field(scene) + ',' + buf;
 }
 
 // One line of best_layouts.md: the fastest layout of a sweep, the fastest direct-mapped one and the
@@ -301,11 +302,10 @@ std::string best_layout_line(const std::string& scene, const std::vector<Run>& r
         return std::string(buf);
     };
     char buf[512];
-    std::snprintf(buf, sizeof buf, "| %s | %s | %s | %s | %s | %s | %s | %s | %.2f |\n", scene.c_str(),
-                  first.structure.c_str(), first.traversal.c_str(), to_string(first.config.access),
+    std::snprintf(buf, sizeof buf, " | %s | %s | %s | %s | %s | %s | %s | %.2f |\n", first.structure.c_str(), first.traversal.c_str(), to_string(first.config.access),
                   node ? "nodes" : "triangles", cell(best).c_str(), cell(best_direct).c_str(), cell(at_study).c_str(),
                   cost(at_study) / cost(best));
-    return buf;
+    return "| " + detail::markdown_cell(scene) + buf;
 }
 
 std::vector<std::string> checked_choices(const std::string& option, const std::vector<std::string>& values,

@@ -147,6 +147,7 @@ bool use_hardware_counters(const std::string& method) {
     if (!hardware && profile::find_valgrind().empty())
         throw Error("valgrind, which counts without hardware counters, is not on PATH (install the valgrind "
                     "package, see packages.txt)");
+    if (!hardware) profile::temp_folder();  // checked before the work, not when callgrind starts
     return hardware;
 }
 

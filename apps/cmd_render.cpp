@@ -223,7 +223,14 @@ Runner add_render(CLI::App& app) {
                             o->accel.device);
             if (o->local_store.enabled) {
                 check_names(o->accel);
-                make_local_store_accelerator(std::span<const Triangle>(&kOneTriangle, 1), modelled_config(), local_store);
+                // The library's refusal is of the budget the caches and the batch exceed: named by the
+                // option that sets it (found by audit, 2026-12-07).
+                try {
+                    make_local_store_accelerator(std::span<const Triangle>(&kOneTriangle, 1), modelled_config(),
+                                                 local_store);
+                } catch (const Error& e) {
+                    throw option_error("--local-store-kib " + std::to_string(o->local_store.kib), e);
+                }
             } else {
                 check_structure(o->accel);
             }

@@ -30,6 +30,7 @@
 
 #include "bench_cluster.hpp"
 #include "bench_common.hpp"
+#include "core/csv.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/error.hpp"
 #include "cellrt/image.hpp"
@@ -291,11 +292,18 @@ nlohmann::json measure_scene(const Scene& scene, const Options& o) {
 Study measure(const Options& o) {
     Study study;
     const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes, o.scenes_named);
+    std::map<std::string, std::string> named;  // scene name -> spec
     cluster::sweep(
         specs.size(), [&](std::size_t i) { return measure_scene(load_scene(specs[i]), o).dump(); },
-        [&](std::size_t, const std::string& result) {
+        [&](std::size_t i, const std::string& result) {
             const nlohmann::json scene = nlohmann::json::parse(result);
-            study.scene_names.push_back(scene["scene"].get<std::string>());
+            const std::string name = scene["scene"].get<std::string>();
+            // The tables and the yardstick's figures look points up by scene: two scenes of one name
+            // showed the first one's figures twice (found by audit, 2026-12-07), as cache-study refuses.
+            if (const auto [at, fresh] = named.emplace(name, specs[i]); !fresh)
+                throw Error(specs[i] + " and " + at->second + " are both the scene '" + name +
+                            "', and the results name their rows by scene: give one view file another \"name\"");
+            study.scene_names.push_back(name);
             for (const nlohmann::json& point : scene["points"]) study.points.push_back(point.get<Point>());
         },
         "measuring the scenes");
@@ -391,8 +399,8 @@ std::string csv_of(const nlohmann::json& rows) {
            "waiting_seconds,efficiency,packet_time_ratio,rays,embree_seconds\n";
     for (const auto& j : rows) {
         const auto optional = [&j](const char* key) { return j.contains(key) ? j[key].dump() : std::string(); };
-        csv << j["scene"].get<std::string>() << ',' << j["config"].get<std::string>() << ','
-            << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["shading"].get<std::string>() << ','
+        csv << detail::csv_field(j["scene"].get<std::string>()) << ',' << detail::csv_field(j["config"].get<std::string>())
+            << ',' << j["dispatch"].get<std::string>() << ',' << j["packet"] << ',' << j["shading"].get<std::string>() << ','
             << optional("ao_samples") << ',' << j["workers"] << ',' << j["seconds"] << ',' << j["busy_seconds"] << ','
             << j["started_seconds"] << ',' << j["waiting_seconds"] << ',' << j["efficiency"] << ','
             << j["packet_time_ratio"] << ',' << j["rays"] << ',' << optional("embree_seconds") << '\n';

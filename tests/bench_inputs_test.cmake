@@ -109,3 +109,24 @@ string(JSON rows LENGTH "${replaced}")
 if(NOT rc EQUAL 0 OR NOT rows EQUAL 1)
   message(FATAL_ERROR "--overwrite: status ${rc}, ${rows} rows in '${replaced}'")
 endif()
+
+# Two scenes of one name: the tables and the yardstick's figures, looked up by scene, showed the first
+# one's twice (found by audit, 2026-12-07); refused as cache-study refuses it.
+# Found once both are measured (their progress lines come first).
+execute_process(COMMAND ${SCALING} --scenes builtin:city?tris=300 builtin:city?tris=400 --size 8x8 --repeats 1
+                        --configs kd --workers 1 --packets 8 --dispatch pull --json ${WORK}/twice.json
+                OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
+string(FIND "${err}" "\ncellrt_scaling: error: builtin:city?tris=400 and builtin:city?tris=300 are both the scene 'city', and the results name their rows by scene: give one view file another \"name\"\n" at)
+if(NOT rc EQUAL 1 OR at LESS 0 OR EXISTS ${WORK}/twice.json)
+  message(FATAL_ERROR "two scenes named city: status ${rc}, printed '${err}'")
+endif()
+
+# A configuration with a comma is one CSV field (its row had a column too many; 2026-12-07).
+execute_process(COMMAND ${SCALING} ${small} --configs kd@leaf_size=4,max_depth=20 --workers 1 --packets 8
+                        --dispatch pull --csv ${WORK}/quoted.csv
+                OUTPUT_QUIET ERROR_VARIABLE err RESULT_VARIABLE rc)
+file(STRINGS ${WORK}/quoted.csv rows)
+list(GET rows 1 row)
+if(NOT rc EQUAL 0 OR NOT row MATCHES "^city,\"kd@leaf_size=4,max_depth=20\",pull,8,")
+  message(FATAL_ERROR "--csv of a configuration with a comma: status ${rc}, '${err}', row '${row}'")
+endif()

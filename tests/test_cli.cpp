@@ -113,18 +113,37 @@ TEST(Cli, InterruptedWriteEndsAsInterrupted) {
     TempDir dir;
     const fs::path fifo = dir.path / "frame.pfm", errors = dir.path / "errors.txt";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-    const pid_t pid = spawn({CELLRT_CLI, "render", "builtin:spheres?tris=200", "--size", "8x8", "-o", fifo.string()},
-                            errors.string());
+    const auto text_of = [](const fs::path& file) {
+        std::ifstream in(file);
+        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    };
+    // A reader that takes nothing yet: the frame (196,620 bytes) fills the pipe and the write waits;
+    // a signal then still ends with the image written whole.
+    const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+    ASSERT_GE(reader, 0);
+    pid_t pid = spawn({CELLRT_CLI, "render", "builtin:spheres?tris=200", "--size", "128x128", "-o", fifo.string()},
+                      errors.string());
     ASSERT_GT(pid, 0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // blocked opening the FIFO
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // blocked writing into the full pipe
     kill(pid, SIGTERM);
-    std::ifstream image(fifo, std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(image)), std::istreambuf_iterator<char>());
+    ASSERT_EQ(::fcntl(reader, F_SETFL, 0), 0);
+    std::string bytes;
+    for (char buf[65536]; const ssize_t n = ::read(reader, buf, sizeof buf);) {
+        if (n < 0) break;
+        bytes.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(reader);
     EXPECT_EQ(wait_exit(pid), 130);
-    EXPECT_EQ(bytes.size(), std::string("PF\n8 8\n-1.0\n").size() + 8 * 8 * 12) << "the image is written whole";
-    std::ifstream in(errors);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    EXPECT_EQ(text, "cellrt: error: interrupted (the outputs were written whole)\n");
+    EXPECT_EQ(bytes.size(), std::string("PF\n128 128\n-1.0\n").size() + 128 * 128 * 12) << "the image is written whole";
+    EXPECT_EQ(text_of(errors), "cellrt: error: interrupted (the outputs were written whole)\n");
+    // No reader at all: the wait for one ends at the signal (it was restarted after every signal, and
+    // only SIGKILL ended it; found by audit, 2026-12-07).
+    pid = spawn({CELLRT_CLI, "render", "builtin:spheres?tris=200", "--size", "8x8", "-o", fifo.string()}, errors.string());
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // waiting for a reader
+    kill(pid, SIGINT);
+    EXPECT_EQ(wait_exit(pid), 130);
+    EXPECT_EQ(text_of(errors), "cellrt: error: " + fifo.string() + ": interrupted while waiting for a reader of the pipe\n");
 }
 
 // A signalled profile kills its callgrind run and removes the run's folder (found by review,
@@ -371,6 +390,9 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "--accel", "bih:branched+auto"},
          "--accel 'bih:branched+auto' names a single-ray kernel ('branched') and SIMD packets ('auto'), which would "
          "replace it: leave one of them out"},
+        {{"info", spheres, "--accel", "brute:loop+auto"},
+         "--accel 'brute:loop+auto' names a single-ray kernel ('loop') and SIMD packets ('auto'), which would "
+         "replace it: leave one of them out"},
         // Options that need no scene, refused before it is loaded, in the option's words (found by
         // audit, 2026-12-07: a 5M-triangle city was made first, and `info` printed half its report).
         {{"render", "builtin:city?tris=5000000", "--size", "0x0", "-o", out}, "--size '0x0' must have both sides in [1, 65536]"},
@@ -433,6 +455,16 @@ TEST(Cli, BadInputIsOneLineAndStatusOne) {
         {{"info", spheres, "--params", "kd"},
          "info: --params KIND prints that structure's parameters and nothing else: give it alone"},
         {{"cache-study", spheres, "--structures", "kd", "kd", "--out", study}, "--structures names 'kd' twice"},
+        // The budget's option named (found by audit, 2026-12-07).
+        {{"render", spheres, "--local-store", "--local-store-kib", "16", "-o", out},
+         "--local-store-kib 16: local store: the configuration needs 47848 bytes, 31464 more than the budget of 16384 "
+         "bytes (node cache 128x128 17408, triangle cache 128x128 17408, traversal stack 744, batch of 256 rays and "
+         "results 12288; caches count 8 directory bytes per line)"},
+        // An output reached through /proc that is the view file (it was appended to; 2026-12-07).
+        {{"render", good_view, "--size", "8x8", "-o", out, "--overwrite", "--stats",
+          "/proc/self/root" + fs::absolute(good_view).string()},
+         "--stats /proc/self/root" + fs::absolute(good_view).string() + " names the scene " + good_view +
+             ", which it would replace"},
     };
     for (const auto& [args, message] : cases) {
         const auto [text, status] = run_for_error(args, dir.path);
@@ -503,6 +535,28 @@ TEST(Cli, StatsOfAFileNamedInAnyBytes) {
     std::ifstream in(stats);
     const std::string json{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     EXPECT_NE(json.find("\"scene\": \"\xef\xbf\xbd\xef\xbf\xbd\""), std::string::npos) << json.substr(0, 200);
+}
+
+// A scene's name is the user's: in the cache study's CSV one field, quoted (a comma in it made one
+// column too many), and one cell of best_layouts.md (found by audit, 2026-12-07).
+TEST(Cli, CacheStudyQuotesTheScenesName) {
+    TempDir dir;
+    std::ofstream(dir.path / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    const std::string view = (dir.path / "odd.json").string(), out = (dir.path / "study").string();
+    std::ofstream(view) << R"({"name": "tea,pot \"x\" | y", "mesh": "tri.obj",
+        "camera": {"position": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0], "up": [0, 1, 0], "fov_y_deg": 45},
+        "light": {"position": [0, 5, 5]}, "image": {"width": 16, "height": 16}})";
+    const auto [text, status] = run_for_error({"cache-study", view, "--structures", "kd", "--traversals", "branched",
+                                               "--access", "sync", "--sweeps", "node", "--out", out},
+                                              dir.path);
+    ASSERT_EQ(status, 0) << text;
+    std::ifstream csv(fs::path(out) / "cache_study.csv"), md(fs::path(out) / "best_layouts.md");
+    std::string header, row, line, table;
+    std::getline(csv, header);
+    std::getline(csv, row);
+    EXPECT_EQ(row.rfind("\"tea,pot \"\"x\"\" | y\",kd,", 0), 0u) << row;
+    while (std::getline(md, line)) table += line + "\n";
+    EXPECT_NE(table.find("| tea,pot \"x\" \\| y | kd |"), std::string::npos) << table;
 }
 
 // The stats' two spans of a frame: the tracing (render_seconds) within the frame from its memory to

@@ -228,6 +228,16 @@ TEST_F(LoaderTest, EmptyMeshIsAnError) {
     }
 }
 
+// The default view of a scene without triangles (a Scene built by hand) was a camera of NaNs, which
+// default_view_problem passed (found by audit, 2026-12-07): now the unit cube's, a camera that works.
+TEST_F(LoaderTest, TheDefaultViewOfNoTrianglesIsACamera) {
+    Scene empty;
+    set_default_view(empty);
+    EXPECT_TRUE(is_finite(empty.camera.position) && is_finite(empty.light.position));
+    EXPECT_NO_THROW(PinholeCamera(empty.camera, 8, 8));
+    EXPECT_EQ(default_view_problem(empty), "");
+}
+
 // A bare mesh is shown by the default view; where that view cannot be made in float (a camera past
 // float's range, an extent whose length overflows, a mesh too small for its distance from the
 // origin), the message names the mesh's span, not a camera the user never gave. Below 1e18 a mesh

@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <fstream>
 #include <future>
+#include <csignal>
 #include <sys/stat.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -51,6 +52,27 @@ TEST(Render, SameImageAtOneAndFourThreads) {
     const Image one = render_with(scene, "brute", 1, 61, 47);
     const Image four = render_with(scene, "brute", 4, 61, 47);
     EXPECT_TRUE(same_bits(one, four));
+}
+
+// The form that reuses a frame's pixels: a moved-from Image keeps its sides and holds no pixels, and
+// was written past its end (found by audit, 2026-12-07); one of other sides is remade.
+TEST(Render, AFrameWithoutItsPixelsIsRemade) {
+    const Scene scene = make_builtin_scene("builtin:spheres?tris=800");
+    const Image expected = render_with(scene, "brute", 2, 61, 47);
+    const auto accel = make_accelerator(scene.triangles, AccelConfig{"brute"});
+    RenderOptions o;
+    o.width = 61;
+    o.height = 47;
+    o.threads = 2;
+    o.packet = 8;
+    Image frame = render(scene, *accel, o);
+    const Image kept = std::move(frame);
+    render(scene, *accel, o, frame);  // NOLINT(bugprone-use-after-move): the moved-from state is the case
+    EXPECT_TRUE(same_bits(frame, expected));
+    EXPECT_TRUE(same_bits(kept, expected));
+    Image other(3, 5);
+    render(scene, *accel, o, other);
+    EXPECT_TRUE(same_bits(other, expected));
 }
 
 // A unit square floor lit from straight above, with a small box floating over its centre: the point
@@ -172,6 +194,63 @@ TEST(Render, ImagesGoIntoPipesAndThroughLinks) {
     ::close(fd);
     std::ifstream logged(log);
     EXPECT_EQ((std::string{std::istreambuf_iterator<char>(logged), std::istreambuf_iterator<char>()}), "first\nsecond\n");
+    logged.close();
+    // One that leads to a file no descriptor of the process writes (`/dev/stdin < kept.json`, a path
+    // through /proc/self/root or /proc/self/cwd) is that file: refused without overwrite, replaced
+    // with it, and an input's other name (found by audit, 2026-12-07: appended to in every case).
+    const int read_only = ::open(log.c_str(), O_RDONLY);
+    ASSERT_GE(read_only, 0);
+    const std::string through_fd = "/proc/self/fd/" + std::to_string(read_only);
+    EXPECT_EQ(test::error_of([&] { write_file_atomically(through_fd, "third\n", false); }),
+              through_fd + ": file exists and overwrite is off");
+    ::close(read_only);
+    const std::string through_root = "/proc/self/root" + std::filesystem::absolute(log).string();
+    EXPECT_EQ(test::error_of([&] { check_output_file(through_root, false); }),
+              through_root + ": file exists (pass --overwrite to replace it)");
+    EXPECT_EQ(test::error_of([&] { check_distinct_files({{"--stats", through_root}}, {{"scene", log}}); }),
+              "--stats " + through_root + " names the scene " + log + ", which it would replace");
+    write_file_atomically(through_root, "replaced\n", true);
+    std::ifstream replaced(log);
+    EXPECT_EQ((std::string{std::istreambuf_iterator<char>(replaced), std::istreambuf_iterator<char>()}), "replaced\n");
+    EXPECT_FALSE(std::filesystem::is_symlink(log));
+    std::filesystem::remove_all(dir);
+}
+
+// A pipe whose reader comes later is waited for; a signal during the wait ends it with an error, even
+// under a handler that asks for restarts (a blocked open was restarted after every signal: a Ctrl-C
+// could not end `cellrt render -o pipe` with no reader; found by audit, 2026-12-07).
+TEST(Render, APipeIsWaitedForUntilItsReaderComesOrASignal) {
+    const auto dir = std::filesystem::temp_directory_path() / ("cellrt_pipe_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string fifo = (dir / "pipe.txt").string();
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const std::string bytes(200000, 'x');  // more than a pipe holds: the writer waits for the reader too
+    std::fflush(stdout);
+    const pid_t reader = ::fork();
+    ASSERT_GE(reader, 0);
+    if (reader == 0) {
+        ::usleep(300000);
+        std::ifstream in(fifo, std::ios::binary);
+        const std::string got{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        ::_exit(got == bytes ? 0 : 5);
+    }
+    write_file_atomically(fifo, bytes, false);
+    int status = 0;
+    ASSERT_EQ(::waitpid(reader, &status, 0), reader);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    const pid_t writer = ::fork();
+    ASSERT_GE(writer, 0);
+    if (writer == 0) {
+        struct sigaction on_alarm {};
+        on_alarm.sa_handler = [](int) {};
+        on_alarm.sa_flags = SA_RESTART;
+        ::sigaction(SIGALRM, &on_alarm, nullptr);
+        ::alarm(1);
+        const std::string message = test::error_of([&] { write_file_atomically(fifo, "no one reads\n", false); });
+        ::_exit(message == fifo + ": interrupted while waiting for a reader of the pipe" ? 0 : 6);
+    }
+    ASSERT_EQ(::waitpid(writer, &status, 0), writer);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
     std::filesystem::remove_all(dir);
 }
 

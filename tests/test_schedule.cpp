@@ -1,11 +1,15 @@
 // The packet scheduler: every dispatch mode, worker count and packet size gives the same image.
 #include <gtest/gtest.h>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -200,6 +204,55 @@ TEST(Schedule, RejectsBadSettings) {
     const PacketTracer nothing = [](unsigned, const PixelRect&, std::span<Vec3>) {};
     EXPECT_EQ(error_of([&] { run_packets(PacketGrid(16, 16, 4), many, image, nothing); }),
               "1025 workers are more than the 1024 a frame may have");
+    // A frame buffer of the grid's sides but not its pixels (a moved-from Image keeps its sides) was
+    // written past its end (found by audit, 2026-12-07).
+    Image hollow;
+    hollow.width = hollow.height = 16;
+    EXPECT_EQ(error_of([&] { run_packets(PacketGrid(16, 16, 4), ScheduleOptions{}, hollow, nothing); }),
+              "frame buffer does not match the packet grid");
+}
+
+// Pinned workers stay on the cores the caller may use: under `taskset -c 1` they were pinned to core 0
+// and core 1 of the machine, or left unpinned where a cpuset refused (found by audit, 2026-12-07).
+TEST(Schedule, PinnedWorkersStayOnTheCallersCores) {
+    cpu_set_t before;
+    ASSERT_EQ(pthread_getaffinity_np(pthread_self(), sizeof before, &before), 0);
+    int last = -1;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &before)) last = c;
+    if (last <= 0) GTEST_SKIP() << "one core only: nothing to tell apart";
+    cpu_set_t only;
+    CPU_ZERO(&only);
+    CPU_SET(last, &only);
+    ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof only, &only), 0);
+    std::mutex m;
+    std::set<int> cpus;
+    Image image(32, 32);
+    for (const Dispatch d : {Dispatch::pull, Dispatch::mailbox}) {
+        ScheduleOptions o;
+        o.dispatch = d;
+        o.workers = 3;
+        o.pin = true;
+        run_packets(PacketGrid(32, 32, 4), o, image, [&](unsigned, const PixelRect&, std::span<Vec3>) {
+            std::lock_guard lock(m);
+            cpus.insert(sched_getcpu());
+        });
+    }
+    pthread_setaffinity_np(pthread_self(), sizeof before, &before);
+    EXPECT_EQ(cpus, std::set<int>{last});
+}
+
+// Sides near INT_MAX: the packet count was rounded up through width + packet - 1, which overflowed
+// (columns() -8388607 for a side of INT_MAX; found by audit, 2026-12-07).
+TEST(Schedule, GridsOfTheLargestSidesCountTheirPackets) {
+    constexpr int kMax = std::numeric_limits<int>::max();
+    const PacketGrid grid(kMax, 1, kMaxPacket);
+    EXPECT_EQ(grid.columns(), kMax / kMaxPacket + 1);
+    EXPECT_EQ(grid.count(), static_cast<std::size_t>(kMax / kMaxPacket + 1));
+    const PixelRect last = grid.rect(grid.count() - 1);
+    EXPECT_EQ(last.x1, kMax);
+    EXPECT_EQ(last.x0, kMax / kMaxPacket * kMaxPacket);
+    EXPECT_EQ(PacketGrid(1, kMax, 7).rows(), (kMax - 1) / 7 + 1);
 }
 
 // A packet that throws on any worker ends the frame under either dispatch mode: run_packets rethrows

@@ -32,8 +32,8 @@ std::unique_ptr<Accelerator> make_accelerator(std::span<const Triangle> triangle
 // It keeps nothing of `triangles`: the tree and its triangles are copied to the device.
 std::unique_ptr<DeviceAccelerator> make_device_accelerator(std::span<const Triangle> triangles, const AccelConfig& config);
 
-// Whether `config` names one of a tree's single-ray kernels (the kd-tree's or the BIH's traversals)
-// together with SIMD packets (simd other than "off"), which trace the batches in its stead: the
+// Whether `config` names one of a tree's single-ray kernels (the kd-tree's or the BIH's traversals,
+// brute force's "loop") together with SIMD packets (simd other than "off"), which trace the batches in its stead: the
 // kernel would be dropped without a word, so make_accelerator refuses it ("kd:rec+auto"). The wide
 // BVH's traversals take an instruction set and are not such kernels.
 bool names_replaced_traversal(const AccelConfig& config);

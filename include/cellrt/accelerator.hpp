@@ -73,11 +73,12 @@ struct AccelStats {
     int simd_lanes = 0;           // rays a SIMD packet traces at once; 0: single rays
     double build_seconds = 0.0;
     double build_cpu_seconds = 0.0;  // the process's CPU time over the build, all threads together
-    std::size_t memory_bytes = 0;
+    std::size_t memory_bytes = 0;  // what the structure holds; not the triangles it reads in place
     std::size_t triangles = 0;
     std::optional<TreeReport> tree;  // kd-tree, BIH and the wide BVH
     // The build settings as used (name, value), in print order: the structure's parameters that shape
-    // its build, Embree's flags, the local store's layout.
+    // its build, Embree's flags, the local store's layout. Embree's also carry what it reports beside
+    // its flags: its device's set-up time, its peak memory, the counters it keeps and its version.
     std::vector<std::pair<std::string, std::string>> settings;
 
     // The printed report, in print order, as (name, value): the fields above but the name, the build

@@ -25,7 +25,8 @@ using ParamTable = std::vector<ParamSpec>;
 // "[min, max]", "true, false" or "a, b, c": the values a parameter accepts, as the tables print them.
 std::string param_range(const ParamSpec& spec);
 
-// A number as the tables print it: whole numbers in full (2^20 as 1048576), others as %g.
+// A number as the tables print it: whole numbers below 1e15 in full (2^20 as 1048576), others as %g
+// (1e15 as 1e+15).
 std::string param_number(double v);
 
 // The table as Markdown: | name | default | range | meaning |.

@@ -48,7 +48,7 @@ struct Scene {
 Scene load_scene(const std::string& spec);
 
 // A camera looking at the whole of `bounds` from the front-upper-right and a light above it; used
-// for bare meshes.
+// for bare meshes. A scene without triangles gets the view of the unit cube around the origin.
 void set_default_view(Scene& scene);
 
 // Why the default view that set_default_view gave `scene` (its light, and its camera too where

@@ -47,8 +47,9 @@ struct PacketGrid {
     int width, height, packet;
 
     PacketGrid(int w, int h, int p);
-    int columns() const { return (width + packet - 1) / packet; }
-    int rows() const { return (height + packet - 1) / packet; }
+    // Rounded up without width + packet - 1, which overflows for a side near INT_MAX (sides are >= 1).
+    int columns() const { return (width - 1) / packet + 1; }
+    int rows() const { return (height - 1) / packet + 1; }
     std::size_t count() const { return static_cast<std::size_t>(columns()) * rows(); }
     PixelRect rect(std::size_t index) const;  // throws cellrt::Error unless index < count()
 };
@@ -63,7 +64,8 @@ struct ScheduleOptions {
     Dispatch dispatch = Dispatch::pull;
     unsigned workers = 0;  // 0: all hardware threads; at most kMaxWorkers
     // Pin worker i to core i (under mailbox dispatch the master to core 0 and worker i to core i + 1;
-    // Linux; ignored where unavailable). Worker 0 (pull) or the master (mailbox) is the calling thread.
+    // Linux; ignored where unavailable), counting the cores the calling thread may use (under taskset
+    // or a cpuset, the i-th of those). Worker 0 (pull) or the master (mailbox) is the calling thread.
     bool pin = false;
     // After the frame the workers poll for the next one this long before they sleep, so that frames
     // drawn back to back do not pay a wake-up per worker (0: sleep at once; docs/SCALING.md).

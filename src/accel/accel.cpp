@@ -107,7 +107,9 @@ bool names_replaced_traversal(const AccelConfig& config) {
     if (config.simd == "off" || config.traversal.empty()) return false;
     const auto& trees = entries();
     const auto e = std::find_if(trees.begin(), trees.end(), [&](const Entry& t) { return t.kind == config.kind; });
-    return e != trees.end() && e->local_store &&
+    // Brute force's "loop" is such a kernel too ("brute:loop+auto" was built as packets and reported
+    // as "packet"; found by audit, 2026-12-07).
+    return e != trees.end() && (e->local_store || e->kind == "brute") &&
            std::find(e->traversals.begin(), e->traversals.end(), config.traversal) != e->traversals.end();
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -10,7 +11,9 @@
 #include <fstream>
 #include <utility>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cellrt/error.hpp"
@@ -22,9 +25,11 @@ namespace {
 namespace fs = std::filesystem;
 
 // What `path` names once links are followed: a regular file, a folder, a stream (a device, a pipe, a
-// socket), or nothing. A path the system keeps under /dev or /proc counts as a stream whatever it
-// leads to: /dev/stdout redirected to a log file leads to a regular file, which renaming over would
-// replace (and truncating would wipe).
+// socket), or nothing. A path the system keeps under /dev or /proc that leads to a regular file this
+// process holds open for writing counts as a stream: /dev/stdout or /dev/fd/3 redirected to a log
+// file, which renaming over would replace (and truncating would wipe). Any other such path is the
+// file it leads to (`/proc/self/cwd/scene.json`, `/dev/stdin < kept.json` were appended to without
+// --overwrite and unchecked against the inputs; found by audit, 2026-12-07).
 enum class Target { none, file, folder, stream };
 
 // The process's own standard output or error when `path` leads to the same file, else null. Their
@@ -43,13 +48,32 @@ std::FILE* own_stream(const std::string& path) {
 
 bool system_path(const std::string& path) { return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0; }
 
+// Whether one of the process's descriptors is open for writing on the file `path` leads to (a shell's
+// `> log` or `3>> log`). Read through /proc/self/fd; without /proc, none is found.
+bool open_for_writing(const std::string& path) {
+    struct stat named {};
+    if (::stat(path.c_str(), &named) != 0) return false;
+    std::error_code ec;
+    for (fs::directory_iterator it("/proc/self/fd", ec), end; !ec && it != end; it.increment(ec)) {
+        int fd = -1;
+        const std::string name = it->path().filename().string();
+        if (std::from_chars(name.data(), name.data() + name.size(), fd).ec != std::errc{}) continue;
+        struct stat st {};
+        if (::fstat(fd, &st) != 0 || st.st_dev != named.st_dev || st.st_ino != named.st_ino) continue;
+        if (const int flags = ::fcntl(fd, F_GETFL); flags >= 0 && (flags & O_ACCMODE) != O_RDONLY) return true;
+    }
+    return false;
+}
+
 Target target_of(const std::string& path) {
     std::error_code ec;
     const fs::file_status st = fs::status(path, ec);
     if (!fs::exists(st)) return Target::none;
     if (fs::is_directory(st)) return Target::folder;
+    if (!fs::is_regular_file(st)) return Target::stream;
     // The process's own output is a stream whatever names it (`--json log > log`, a link to /dev/stdout).
-    return fs::is_regular_file(st) && !system_path(path) && !own_stream(path) ? Target::file : Target::stream;
+    if (own_stream(path) || (system_path(path) && open_for_writing(path))) return Target::stream;
+    return Target::file;
 }
 
 // A path as the file it names: links and dots resolved where the system can, else as written. Its
@@ -74,7 +98,10 @@ fs::path file_named(const std::string& path) {
 
 fs::path folder_of(const fs::path& file) { return file.has_parent_path() ? file.parent_path() : fs::path("."); }
 
-// Appended, so that a stream that leads to a file (a shell's `> log`) is not truncated.
+// Appended, so that a stream that leads to a file (a shell's `> log`) is not truncated. A pipe no
+// process reads yet is waited for in steps of 10 ms, which a signal ends (a blocked open was
+// restarted after every signal, so that a Ctrl-C could not end a write to a pipe no one read; found
+// by audit, 2026-12-07); once a reader is there, the bytes are written whole, as to a file.
 void write_in_place(const std::string& path, std::string_view bytes) {
     if (std::FILE* stream = own_stream(path)) {
         if (std::fflush(stream) != 0 || std::fwrite(bytes.data(), 1, bytes.size(), stream) != bytes.size() ||
@@ -82,11 +109,29 @@ void write_in_place(const std::string& path, std::string_view bytes) {
             throw Error(path + ": write failed");
         return;
     }
-    std::ofstream out(path, std::ios::binary | std::ios::app);
-    if (!out) throw Error(path + ": cannot be opened for writing");
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw Error(path + ": write failed");
+    int fd = -1;
+    while ((fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_NONBLOCK | O_CLOEXEC)) < 0) {
+        const int error = errno;
+        if (error == EINTR) continue;
+        if (error != ENXIO) throw Error(path + ": cannot be opened for writing (" + std::strerror(error) + ")");
+        const timespec step{0, 10'000'000};
+        if (::nanosleep(&step, nullptr) != 0) throw Error(path + ": interrupted while waiting for a reader of the pipe");
+    }
+    const auto failed = [&](int error) {
+        ::close(fd);
+        return Error(path + ": write failed (" + std::strerror(error) + ")");
+    };
+    if (const int flags = ::fcntl(fd, F_GETFL); flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0)
+        throw failed(errno);
+    for (std::size_t done = 0; done < bytes.size();) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n > 0) done += static_cast<std::size_t>(n);
+        else if (n == 0 || errno != EINTR) throw failed(n == 0 ? EIO : errno);
+    }
+    if (::close(fd) != 0) {
+        const int error = errno;
+        throw Error(path + ": write failed (" + std::strerror(error) + ")");
+    }
 }
 
 // A path under /dev or /proc that leads nowhere (`/dev/stdout` of a process whose stdout is closed):

@@ -29,13 +29,24 @@ extern char** environ;
 
 namespace cellrt::profile {
 namespace fs = std::filesystem;
+
+std::string temp_folder() {
+    std::error_code ec;
+    const fs::path folder = fs::temp_directory_path(ec);
+    if (!ec) return folder.string();
+    const char* tmpdir = std::getenv("TMPDIR");
+    throw Error(std::string("the temporary folder") +
+                (tmpdir ? " $TMPDIR '" + std::string(tmpdir) + "'" : std::string(" /tmp")) +
+                " is not a folder (" + ec.message() + "): set TMPDIR to one callgrind's runs can be made in");
+}
+
 namespace {
 
 // A private temporary folder, removed with everything in it.
 class TempDir {
 public:
     TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "cellrt-callgrind-XXXXXX").string();
+        std::string pattern = (fs::path(temp_folder()) / "cellrt-callgrind-XXXXXX").string();
         if (!::mkdtemp(pattern.data()))
             throw Error("cannot create a temporary folder: " + std::string(std::strerror(errno)));
         path_ = pattern;

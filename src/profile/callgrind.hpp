@@ -31,6 +31,11 @@ struct CallgrindOptions {
 // valgrind's path if it is on PATH, else empty.
 std::string find_valgrind();
 
+// The folder callgrind's runs are made in: the system's temporary folder ($TMPDIR, else /tmp). Throws
+// cellrt::Error naming $TMPDIR and its value when it is not a folder (the error was the standard
+// library's "filesystem error: temp_directory_path: No such file or directory", after the work).
+std::string temp_folder();
+
 // Runs `command` (program and arguments; no shell) under callgrind and returns the events it
 // collected. The program's own output is kept out of the way and shown only if it fails. Throws
 // cellrt::Error when valgrind is missing, the run fails or its output cannot be read.

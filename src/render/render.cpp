@@ -165,7 +165,9 @@ void FrameRenderer::render_window(const PixelRect& window, Image& image, RenderS
         throw Error("window [" + std::to_string(window.x0) + ", " + std::to_string(window.x1) + ") x [" +
                     std::to_string(window.y0) + ", " + std::to_string(window.y1) + ") is not inside the " +
                     std::to_string(options.width) + "x" + std::to_string(options.height) + " frame");
-    if (image.width != window.width() || image.height != window.height())
+    // Its pixels too: a moved-from Image keeps its sides and holds none.
+    if (image.width != window.width() || image.height != window.height() ||
+        image.pixels.size() != static_cast<std::size_t>(window.pixels()))
         image = Image(window.width(), window.height());
     if (state_->device) {
         render_on_device(window, image, stats);

@@ -23,7 +23,9 @@ Box3 Scene::bounds() const {
 }
 
 void set_default_view(Scene& scene) {
-    const Box3 b = scene.bounds();
+    // A scene without triangles is viewed as the unit cube around the origin: its empty bounds gave a
+    // camera of NaNs (found by audit, 2026-12-07).
+    const Box3 b = scene.triangles.empty() ? Box3{Vec3{-0.5f}, Vec3{0.5f}} : scene.bounds();
     const Vec3 c = b.center();
     const float radius = std::max(0.5f * length(b.extent()), 1e-6f);
     const Vec3 dir = normalize(Vec3{1.f, 0.6f, 1.4f});

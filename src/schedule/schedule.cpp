@@ -279,7 +279,7 @@ PixelRect PacketGrid::rect(std::size_t index) const {
     const int cx = static_cast<int>(index % static_cast<std::size_t>(columns()));
     const int cy = static_cast<int>(index / static_cast<std::size_t>(columns()));
     const int x0 = cx * packet, y0 = cy * packet;
-    return {x0, y0, std::min(x0 + packet, width), std::min(y0 + packet, height)};
+    return {x0, y0, x0 + std::min(packet, width - x0), y0 + std::min(packet, height - y0)};
 }
 
 void packet_order(const PixelRect& rect, std::span<std::uint32_t> order) {
@@ -308,7 +308,9 @@ unsigned worker_count(const ScheduleOptions& options) {
 
 bool run_packets(const PacketGrid& grid, const ScheduleOptions& options, Image& image, const PacketTracer& trace,
                  std::vector<WorkerLoad>* loads) {
-    if (image.width != grid.width || image.height != grid.height) throw Error("frame buffer does not match the packet grid");
+    if (image.width != grid.width || image.height != grid.height ||
+        image.pixels.size() != static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height))
+        throw Error("frame buffer does not match the packet grid");
     std::vector<PaddedLoad> padded(worker_count(options));
     const Timer frame;
     const bool complete = options.dispatch == Dispatch::pull ? run_pull(grid, options, image, trace, frame, padded)

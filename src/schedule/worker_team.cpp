@@ -75,16 +75,26 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
         }
         signals_.push_back(std::move(signal));
     }
-    set_affinity(pin);
 #ifdef __linux__
+    // The cores the caller may use, in order: job j is pinned to the j-th of them, so that a run under
+    // taskset or a cpuset stays on the cores it was given (job j was pinned to the machine's core j,
+    // outside the set, where the system refused it and the run went unpinned; found by audit,
+    // 2026-12-07).
     cpu_set_t caller_affinity;
-    if (pin) {
-        pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
-        cpu_set_t core0;
-        CPU_ZERO(&core0);
-        CPU_SET(0, &core0);
-        pthread_setaffinity_np(pthread_self(), sizeof core0, &core0);
+    CPU_ZERO(&caller_affinity);
+    pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
+    std::vector<int> allowed;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &caller_affinity)) allowed.push_back(c);
+    set_affinity(pin, allowed);
+    if (pin && !allowed.empty()) {
+        cpu_set_t first;
+        CPU_ZERO(&first);
+        CPU_SET(allowed.front(), &first);
+        pthread_setaffinity_np(pthread_self(), sizeof first, &first);
     }
+#else
+    set_affinity(pin, {});
 #endif
     job_ = &job;
     spin_microseconds_.store(spin.count(), std::memory_order_relaxed);
@@ -136,25 +146,25 @@ void WorkerTeam::loop(unsigned t, Signal& signal) {
     }
 }
 
-void WorkerTeam::set_affinity(bool pin) {
+void WorkerTeam::set_affinity(bool pin, const std::vector<int>& allowed) {
 #ifdef __linux__
-    // Pinned: thread t (job t + 1) on core t + 1 (modulo the cores). Free: every core this process may use.
-    if (!pin && !pinned_) return;
-    cpu_set_t allowed;
-    CPU_ZERO(&allowed);
-    sched_getaffinity(0, sizeof allowed, &allowed);
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    // Pinned: thread t (job t + 1) on allowed[t + 1] (modulo their count). Free: every allowed core.
+    if ((!pin && !pinned_) || allowed.empty()) return;
+    cpu_set_t all;
+    CPU_ZERO(&all);
+    for (const int c : allowed) CPU_SET(c, &all);
     for (unsigned t = 0; t < threads_.size(); ++t) {
-        cpu_set_t set = allowed;
+        cpu_set_t set = all;
         if (pin) {
             CPU_ZERO(&set);
-            CPU_SET((t + 1) % cores, &set);
+            CPU_SET(allowed[(t + 1) % allowed.size()], &set);
         }
         pthread_setaffinity_np(threads_[t].native_handle(), sizeof set, &set);
     }
     pinned_ = pin;
 #else
     (void)pin;
+    (void)allowed;
 #endif
 }
 

@@ -40,7 +40,8 @@ public:
     // Runs job(j) for every j in [0, n) at once and returns when every call has returned: job 0 on
     // the calling thread, job j > 0 on thread j - 1 of the team (always the same thread; the team
     // grows to n - 1 threads on first need; threads beyond n - 1 are left as they are). With `pin`,
-    // job j runs on core j (the caller's own affinity is restored afterwards); otherwise anywhere.
+    // job j runs on the j-th core the caller may use, modulo their count (the caller's own affinity is
+    // restored afterwards); otherwise anywhere the caller may run.
     // After the run the threads that took part poll for their next one for `spin` before they sleep
     // (0: sleep at once). One run at a time: a second caller waits for the first; a job must not call
     // run() itself. An exception from any job is rethrown once every job has returned (the first one
@@ -55,7 +56,8 @@ private:
     };
 
     void loop(unsigned t, Signal& signal);
-    void set_affinity(bool pin);
+    // `allowed`: the cores the caller may use, in order.
+    void set_affinity(bool pin, const std::vector<int>& allowed);
     // Runs job(j), keeping the first exception of the run in failure_.
     void run_job(unsigned j);
 

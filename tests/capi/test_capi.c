@@ -364,6 +364,8 @@ static int part_errors(void) {
                 "'kd:rec+auto' names a single-ray kernel ('rec') and SIMD packets ('auto'), which would replace it");
     CHECK(cellrt_accel_new(scene, "bih:branchless+avx2") == NULL);
     CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "names a single-ray kernel ('branchless')");
+    CHECK(cellrt_accel_new(scene, "brute:loop+sse") == NULL);
+    CHECK_ERROR(device, CELLRT_ERROR_INVALID_CONFIG, "names a single-ray kernel ('loop')");
     accel = cellrt_accel_new(scene, "bvh:paired+auto");
     CHECK(accel != NULL && cellrt_accel_release(accel) == CELLRT_SUCCESS);
     fallback = cellrt_accel_new(scene, NULL); /* NULL: the CPU's default, auto@packets=bvh */
