@@ -313,8 +313,15 @@ unsigned small_count(py::handle object, const std::string& name, unsigned max, u
     const std::string range = " must be an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
     if (is_bool(object) || PyIndex_Check(object.ptr()) == 0)
         throw py::value_error(name + range + ", got " + py::repr(object).cast<std::string>());
+    // Every numpy array passes PyIndex_Check; one that is not an integer scalar raised numpy's bare
+    // TypeError (found by audit, 2026-12-07). An __index__ of the caller's own that raises otherwise
+    // keeps its exception.
     const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(object.ptr()));
-    if (!index) throw py::error_already_set();
+    if (!index) {
+        if (!PyErr_ExceptionMatches(PyExc_TypeError)) throw py::error_already_set();
+        PyErr_Clear();
+        throw py::value_error(name + range + ", got " + py::repr(object).cast<std::string>());
+    }
     int overflow = 0;
     const long long value = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
     if (overflow != 0 || value < static_cast<long long>(min) || value > static_cast<long long>(max))

@@ -6,6 +6,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -23,11 +24,15 @@ namespace cellrt::python {
 // search takes at once (src/packet/packet_kernels.inl), and few enough for the stack.
 inline constexpr std::size_t kChunk = 1024;
 
-// The threads a batch is traced on: all (TBB's default arena) or an arena of `threads`.
+// The threads a batch is traced on: all (TBB's default arena) or an arena of `threads`, never more
+// than the machine has, as a build's (an arena of more printed TBB's warning on every batch; found by
+// audit, 2026-12-07).
 class Team {
 public:
     explicit Team(unsigned threads) {
-        if (threads > 0) arena_ = std::make_unique<tbb::task_arena>(static_cast<int>(threads));
+        if (threads > 0)
+            arena_ = std::make_unique<tbb::task_arena>(
+                static_cast<int>(std::min(threads, static_cast<unsigned>(tbb::info::default_concurrency()))));
     }
 
     // Calls f(begin, end) for every chunk of [0, count), on the team's threads; a batch of one chunk

@@ -5,8 +5,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <thread>
+#include <type_traits>
 
 #include "arrays.hpp"
 #include "batch.hpp"
@@ -29,6 +34,58 @@ struct PyAccelerator {
     Team team;
     AccelConfig config;  // as built
 };
+
+// A thread that takes the GIL back while the interpreter finalizes is ended by pthread_exit, whose
+// unwinding runs pybind11's destructors without the GIL (Py_DECREF racing the finalizing collector: a
+// segmentation fault) or out of py::gil_scoped_release's noexcept destructor (std::terminate), for a
+// daemon thread in any call at exit (found by audit, 2026-12-07). So a thread that comes back from
+// the library once the interpreter has begun to exit waits there for the process to end, as Python
+// 3.14 makes such threads do itself. `exiting` is set by an atexit callback, which runs before the
+// interpreter is marked finalizing and then waits, with the GIL released, for the threads already on
+// their way back (`returning`); with sequentially consistent atomics each side sees the other.
+std::atomic<bool> exiting{false};
+std::atomic<int> returning{0};
+std::thread::id exit_thread;  // the thread that runs the atexit callbacks, which may still call the module
+
+void at_interpreter_exit() {
+    exit_thread = std::this_thread::get_id();
+    exiting.store(true);
+    const py::gil_scoped_release unlocked;
+    while (returning.load() != 0) std::this_thread::yield();
+}
+
+void take_gil_back(PyThreadState* state) {
+    returning.fetch_add(1);
+    if (exiting.load() && std::this_thread::get_id() != exit_thread)
+        for (;;) std::this_thread::sleep_for(std::chrono::hours(24));
+    PyEval_RestoreThread(state);
+    returning.fetch_sub(1);
+}
+
+// Runs `f` with the GIL released, taken back by take_gil_back (never in a destructor).
+template <class F>
+auto without_gil(F&& f) {
+    PyThreadState* const state = PyEval_SaveThread();
+    if constexpr (std::is_void_v<decltype(f())>) {
+        try {
+            f();
+        } catch (...) {
+            take_gil_back(state);
+            throw;
+        }
+        take_gil_back(state);
+    } else {
+        std::optional<decltype(f())> result;
+        try {
+            result.emplace(f());
+        } catch (...) {
+            take_gil_back(state);
+            throw;
+        }
+        take_gil_back(state);
+        return std::move(*result);
+    }
+}
 
 }  // namespace
 }  // namespace cellrt::python
@@ -116,9 +173,10 @@ std::string param_value(py::handle value, const std::string& name) {
     if (py::isinstance<py::str>(value)) return text(value, name);
     if (is_bool(value)) return PyObject_IsTrue(value.ptr()) ? "true" : "false";
     if (PyIndex_Check(value.ptr()) != 0) {
-        const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-        if (!index) throw py::error_already_set();
-        return py::str(index);
+        // Every numpy array passes PyIndex_Check; np.array([1]) raised numpy's bare TypeError.
+        if (const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()))) return py::str(index);
+        if (!PyErr_ExceptionMatches(PyExc_TypeError)) throw py::error_already_set();
+        PyErr_Clear();
     }
     if (py::isinstance<py::float_>(value) || is_numpy_kind(value, 'f'))
         return py::repr(py::float_(py::reinterpret_borrow<py::object>(value))).cast<std::string>();
@@ -158,8 +216,7 @@ AccelConfig accel_config(py::handle kind, py::handle simd, py::handle threads, p
 
 std::unique_ptr<PyAccelerator> build(std::vector<Triangle> triangles, const AccelConfig& config) {
     auto a = std::make_unique<PyAccelerator>(PyAccelerator{std::move(triangles), nullptr, Team(config.threads), config});
-    py::gil_scoped_release unlocked;
-    a->accel = make_accelerator(a->triangles, config);
+    a->accel = without_gil([&] { return make_accelerator(a->triangles, config); });
     return a;
 }
 
@@ -170,11 +227,7 @@ py::dict py_intersect(const PyAccelerator& a, py::handle origins, py::handle dir
     py::array_t<float> t(n), u(n), v(n);
     py::array_t<std::int64_t> prim(n);
     const HitOutput out{t.mutable_data(), prim.mutable_data(), u.mutable_data(), v.mutable_data()};
-    std::size_t invalid;
-    {
-        py::gil_scoped_release unlocked;
-        invalid = intersect(*a.accel, a.team, in, out);
-    }
+    const std::size_t invalid = without_gil([&] { return intersect(*a.accel, a.team, in, out); });
     if (invalid != kAllValid) throw py::value_error(invalid_ray_message(in, invalid));
     py::dict d;
     d["t"] = t;
@@ -190,11 +243,7 @@ py::array_t<bool> py_occluded(const PyAccelerator& a, py::handle origins, py::ha
     py::array_t<bool> out(static_cast<py::ssize_t>(in.count));
     static_assert(sizeof(bool) == sizeof(std::uint8_t));
     auto* bytes = reinterpret_cast<std::uint8_t*>(out.mutable_data());
-    std::size_t invalid;
-    {
-        py::gil_scoped_release unlocked;
-        invalid = occluded(*a.accel, a.team, in, bytes);
-    }
+    const std::size_t invalid = without_gil([&] { return occluded(*a.accel, a.team, in, bytes); });
     if (invalid != kAllValid) throw py::value_error(invalid_ray_message(in, invalid));
     return out;
 }
@@ -263,12 +312,10 @@ py::array render_scene(py::handle scene_object, py::handle kind, py::handle size
     // A copy: the render runs without the GIL, while Python may change the scene's camera.
     const Scene scene = scene_object.cast<const Scene&>();
     std::tie(ro.width, ro.height) = size.is_none() ? std::pair{scene.width, scene.height} : image_size(size);
-    Image image;
-    {
-        py::gil_scoped_release unlocked;
+    Image image = without_gil([&] {
         const std::unique_ptr<Accelerator> accel = make_accelerator(scene.triangles, config);
-        image = render(scene, *accel, ro);
-    }
+        return render(scene, *accel, ro);
+    });
     return image_array(std::move(image));
 }
 
@@ -285,8 +332,7 @@ std::shared_ptr<Scene> load(py::handle path) {
     if (!py::isinstance<py::str>(p))
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());
     const std::string spec = text(p, "path", true);
-    py::gil_scoped_release unlocked;
-    return std::make_shared<Scene>(load_scene(spec));
+    return without_gil([&] { return std::make_shared<Scene>(load_scene(spec)); });
 }
 
 py::tuple camera_rays(const Camera& camera, py::handle width, py::handle height) {
@@ -316,6 +362,7 @@ PYBIND11_MODULE(cellrt, m) {
     using namespace cellrt::python;
     m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
     m.attr("__version__") = CELLRT_VERSION_STRING;
+    py::module_::import("atexit").attr("register")(py::cpp_function(&at_interpreter_exit));
     static const py::exception<Error>& error_type = py::register_exception<Error>(m, "Error", PyExc_ValueError);
     error_type.attr("__doc__") = "What the library refuses (a file, a configuration, a camera), with its message naming "
                                  "the file and line, the field or the parameter at fault; a ValueError.";
@@ -353,7 +400,8 @@ PYBIND11_MODULE(cellrt, m) {
         .def_readonly("traversal", &AccelStats::traversal, "the single-ray kernel, 'packet' (SIMD packets), or Embree's")
         .def_readonly("simd_lanes", &AccelStats::simd_lanes, "rays a SIMD packet traces at once; 0: single rays")
         .def_readonly("build_seconds", &AccelStats::build_seconds, "the build's wall-clock time")
-        .def_readonly("memory_bytes", &AccelStats::memory_bytes, "the structure's memory, triangles included")
+        .def_readonly("memory_bytes", &AccelStats::memory_bytes, "the bytes the structure holds: its nodes, indices and triangle copies of its own; not the triangles "
+                       "it reads in place (kd, bih, brute: 0 for brute)")
         .def_readonly("triangles", &AccelStats::triangles, "the triangles it was built over")
         .def_readonly("tree", &AccelStats::tree, "TreeReport (kd-tree, BIH, BVH) or None")
         .def_property_readonly(
@@ -514,7 +562,7 @@ PYBIND11_MODULE(cellrt, m) {
           py::arg("size") = py::none(), py::arg("shading") = "direct", py::arg("threads") = 0, py::arg("ao_samples") = 4,
           py::arg("device") = "cpu",
           "The scene rendered as cellrt render renders it: an (H, W, 3) float32 array, the values of its PFM, row 0 "
-          "at the top, the same bits with every kind (None: the library's default, as for Accelerator). "
+          "at the top, the same bits with every kind but 'embree' (None: the library's default, as for Accelerator). "
           "device='cuda': every pixel made on the GPU, the same array bit for bit.");
     m.def(
         "device_info",
@@ -542,8 +590,7 @@ PYBIND11_MODULE(cellrt, m) {
             if (which != "wall" && which != "cpu") throw py::value_error("clock must be 'wall' or 'cpu'");
             const RayInput in = ray_input(origins, directions, py::float_(0.0),
                                           py::float_(std::numeric_limits<double>::infinity()));
-            py::gil_scoped_release unlocked;
-            return native_intersect_seconds(*a.accel, a.team, in, repeats, which == "cpu");
+            return without_gil([&] { return native_intersect_seconds(*a.accel, a.team, in, repeats, which == "cpu"); });
         },
         py::arg("accelerator"), py::arg("origins"), py::arg("directions"), py::arg("repeats"), py::arg("clock") = "wall");
 }

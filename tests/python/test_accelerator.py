@@ -70,7 +70,7 @@ def test_a_tree_kernel_runs_alone_and_is_refused_with_packets(case):
     # packets would replace it, it is refused (it ran the packets and reported the kernel until an
     # audit, 2026-12-07).
     scene, rays, hits, _ = case
-    for kind in ("kd:rec", "bih:branchless"):
+    for kind in ("kd:rec", "bih:branchless", "brute:loop"):
         acc = cellrt.Accelerator(scene.triangles, kind=kind)
         assert acc.config == kind and acc.stats.traversal == kind.split(":")[1]
         assert_same_hits(acc.intersect(*rays), hits)
@@ -236,6 +236,37 @@ def test_the_interpreter_ends_while_a_daemon_thread_renders():
             "time.sleep(0.3)\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("call", ["acc.intersect(o, d)", "acc.occluded(o, d)", "cellrt.Accelerator(tri)",
+                                  "cellrt.load_scene('builtin:spheres?tris=100')"])
+def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
+    # Short calls in a loop: the thread took the GIL back as the interpreter finalized, which ended it
+    # by pthread_exit; unwinding out of py::gil_scoped_release's destructor was std::terminate
+    # (status 134; found by audit, 2026-12-07), and unwinding pybind11's frames without the GIL a
+    # segmentation fault in one run of three.
+    code = ("import threading, time, numpy as np, cellrt\n"
+            "tri = np.eye(3, dtype=np.float32)[None]\n"
+            "acc = cellrt.Accelerator(tri)\n"
+            "o = np.zeros((8, 3), np.float32); d = np.ones((8, 3), np.float32)\n"
+            "def loop():\n"
+            "    while True:\n"
+            f"        {call}\n"
+            "threading.Thread(target=loop, daemon=True).start()\n"
+            "time.sleep(0.2)\n")
+    for _ in range(5):
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+
+
+def test_more_threads_than_cores_trace_without_a_word():
+    # An arena of more threads than cores printed TBB's warning on stderr (found by audit, 2026-12-07).
+    code = ("import numpy as np, cellrt\n"
+            "a = cellrt.Accelerator(np.eye(3, dtype=np.float32)[None], threads=1024)\n"
+            "o = np.random.default_rng(1).random((5000, 3)).astype(np.float32)\n"
+            "a.intersect(o, o - 0.5); a.occluded(o, o - 0.5)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
 
 
 def test_stats_are_typed(city):

@@ -464,6 +464,15 @@ def test_numpy_scalars_count_as_what_they_hold():
     refused(r"size\[0\] must be an integer in \[1, 65536\], got True", cellrt.render, cellrt.Scene(TRI),
             size=(np.bool_(True), 4))
     assert cellrt.render(cellrt.Scene(TRI), size=(np.int64(4), np.uint8(3))).shape == (3, 4, 3)
+    # Arrays are not counts: numpy's bare TypeError came through (found by audit, 2026-12-07).
+    refused(r"threads must be an integer in \[0, 1024\], got array\(\[2\]\)", cellrt.Accelerator, TRI,
+            threads=np.array([2]))
+    refused(r"threads must be an integer in \[0, 1024\], got array\(2\.\)", cellrt.Accelerator, TRI,
+            threads=np.array(2.0))
+    refused(r"size\[0\] must be an integer in \[1, 65536\], got array\(\[4\]\)", cellrt.render,
+            cellrt.Scene(TRI), size=(np.array([4]), 3))
+    refused(r"must be a str, bool, int or float, got array\(\[1\]\)", cellrt.Accelerator, TRI, kind="kd",
+            params={"leaf_size": np.array([1])})
 
 
 @pytest.mark.parametrize("make", [lambda: cellrt.Camera(), lambda: cellrt.Light(), lambda: cellrt.Scene(TRI),
