@@ -56,8 +56,10 @@ void at_interpreter_exit() {
 
 void take_gil_back(PyThreadState* state) {
     returning.fetch_add(1);
-    if (exiting.load() && std::this_thread::get_id() != exit_thread)
+    if (exiting.load() && std::this_thread::get_id() != exit_thread) {
+        returning.fetch_sub(1);  // not on its way back: the callback must not wait for it
         for (;;) std::this_thread::sleep_for(std::chrono::hours(24));
+    }
     PyEval_RestoreThread(state);
     returning.fetch_sub(1);
 }

@@ -244,7 +244,8 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
     # Short calls in a loop: the thread took the GIL back as the interpreter finalized, which ended it
     # by pthread_exit; unwinding out of py::gil_scoped_release's destructor was std::terminate
     # (status 134; found by audit, 2026-12-07), and unwinding pybind11's frames without the GIL a
-    # segmentation fault in one run of three.
+    # segmentation fault in one run of three. Three threads: one that stops for the exit must not be
+    # counted as on its way back (the exit waited for it: a hang, found by the full test run).
     code = ("import threading, time, numpy as np, cellrt\n"
             "tri = np.eye(3, dtype=np.float32)[None]\n"
             "acc = cellrt.Accelerator(tri)\n"
@@ -252,7 +253,8 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
             "def loop():\n"
             "    while True:\n"
             f"        {call}\n"
-            "threading.Thread(target=loop, daemon=True).start()\n"
+            "for _ in range(3):\n"
+            "    threading.Thread(target=loop, daemon=True).start()\n"
             "time.sleep(0.2)\n")
     for _ in range(5):
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
