@@ -8,6 +8,7 @@
 
 #include "cellrt/error.hpp"
 #include "cellrt/version.hpp"
+#include "core/files.hpp"
 #include "cli.hpp"
 #include "cluster.hpp"
 
@@ -45,6 +46,7 @@ int run(int argc, char** argv) {
     g_say_interrupted = cli::cluster::ranks() == 1;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
+    set_write_cancel(&cli::g_cancel);  // a signal before a wait for a pipe's reader ends it too
     try {
         // Under MPI only the commands whose work splits over the ranks run (docs/DISTRIBUTED.md).
         static const char* const kNames[] = {"render", "info", "profile", "cache-study"};

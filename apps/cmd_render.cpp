@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <string>
+#include <string_view>
 
 #include "accel/local_store_registry.hpp"
 #include "cellrt/builtin.hpp"
@@ -229,7 +231,9 @@ Runner add_render(CLI::App& app) {
                     make_local_store_accelerator(std::span<const Triangle>(&kOneTriangle, 1), modelled_config(),
                                                  local_store);
                 } catch (const Error& e) {
-                    throw option_error("--local-store-kib " + std::to_string(o->local_store.kib), e);
+                    if (std::string_view(e.what()).starts_with("local store: "))
+                        throw option_error("--local-store-kib " + std::to_string(o->local_store.kib), e);
+                    throw;
                 }
             } else {
                 check_structure(o->accel);

@@ -293,6 +293,7 @@ Study measure(const Options& o) {
     Study study;
     const std::vector<std::string> specs = bench::found_scenes(o.scenes_dir, o.scenes, o.scenes_named);
     std::map<std::string, std::string> named;  // scene name -> spec
+    std::string twice;                         // the refusal of a second scene of one name, on the leader
     cluster::sweep(
         specs.size(), [&](std::size_t i) { return measure_scene(load_scene(specs[i]), o).dump(); },
         [&](std::size_t i, const std::string& result) {
@@ -300,13 +301,15 @@ Study measure(const Options& o) {
             const std::string name = scene["scene"].get<std::string>();
             // The tables and the yardstick's figures look points up by scene: two scenes of one name
             // showed the first one's figures twice (found by audit, 2026-12-07), as cache-study refuses.
-            if (const auto [at, fresh] = named.emplace(name, specs[i]); !fresh)
-                throw Error(specs[i] + " and " + at->second + " are both the scene '" + name +
-                            "', and the results name their rows by scene: give one view file another \"name\"");
+            if (const auto [at, fresh] = named.emplace(name, specs[i]); !fresh && twice.empty())
+                twice = specs[i] + " and " + at->second + " are both the scene '" + name +
+                        "', and the results name their rows by scene: give one view file another \"name\"";
             study.scene_names.push_back(name);
             for (const nlohmann::json& point : scene["points"]) study.points.push_back(point.get<Point>());
         },
         "measuring the scenes");
+    // Refused on every rank at once: the leader alone throwing left the others in a collective.
+    cluster::together([&] { if (!twice.empty()) throw Error(twice); }, "naming the scenes");
     return study;
 }
 
@@ -337,7 +340,7 @@ void print_seconds_table(const Study& study, const Options& o, const std::string
     for (std::size_t i = 0; i <= o.workers.size(); ++i) std::printf("---|");
     std::printf("\n");
     for (const std::string& scene : study.scene_names) {
-        std::printf("| %s |", scene.c_str());
+        std::printf("| %s |", detail::markdown_cell(scene).c_str());
         for (unsigned w : o.workers) {
             const Point* pt = find(study.points, scene, config, d, p, w);
             const Point* y = yardstick.empty() ? nullptr : find(study.points, scene, yardstick, d, p, w);
@@ -365,7 +368,7 @@ void print_time_shares(const Study& study, const Options& o, const std::string& 
         const double all = last->seconds * most;
         const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
                      waiting = last->waiting_seconds / all;
-        std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", scene.c_str(), tracing, waking,
+        std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", detail::markdown_cell(scene).c_str(), tracing, waking,
                     std::max(0.0, 1.0 - tracing - waking - waiting), waiting, last->packet_time_ratio);
     }
 }

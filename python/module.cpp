@@ -5,7 +5,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <atomic>
+#ifdef __GLIBCXX__
+#include <cxxabi.h>
+#endif
+
 #include <chrono>
 #include <limits>
 #include <memory>
@@ -35,33 +38,23 @@ struct PyAccelerator {
     AccelConfig config;  // as built
 };
 
-// A thread that takes the GIL back while the interpreter finalizes is ended by pthread_exit, whose
-// unwinding runs pybind11's destructors without the GIL (Py_DECREF racing the finalizing collector: a
-// segmentation fault) or out of py::gil_scoped_release's noexcept destructor (std::terminate), for a
-// daemon thread in any call at exit (found by audit, 2026-12-07). So a thread that comes back from
-// the library once the interpreter has begun to exit waits there for the process to end, as Python
-// 3.14 makes such threads do itself. `exiting` is set by an atexit callback, which runs before the
-// interpreter is marked finalizing and then waits, with the GIL released, for the threads already on
-// their way back (`returning`); with sequentially consistent atomics each side sees the other.
-std::atomic<bool> exiting{false};
-std::atomic<int> returning{0};
-std::thread::id exit_thread;  // the thread that runs the atexit callbacks, which may still call the module
-
-void at_interpreter_exit() {
-    exit_thread = std::this_thread::get_id();
-    exiting.store(true);
-    const py::gil_scoped_release unlocked;
-    while (returning.load() != 0) std::this_thread::yield();
-}
-
+// A thread that takes the GIL back while the interpreter finalizes is ended by pthread_exit (Python
+// before 3.14), whose unwinding ran pybind11's destructors without the GIL (Py_DECREF racing the
+// finalizing collector: a segmentation fault) or out of py::gil_scoped_release's noexcept destructor
+// (std::terminate), for a daemon thread in any call at exit (found by audit, 2026-12-07). The
+// unwinding is caught where it starts, and the thread waits there for the process to end, as Python
+// 3.14 makes such threads do itself; it holds no GIL. Nothing else changes: a thread coming back
+// before finalization takes the GIL as usual (an atexit callback that joins it still can).
 void take_gil_back(PyThreadState* state) {
-    returning.fetch_add(1);
-    if (exiting.load() && std::this_thread::get_id() != exit_thread) {
-        returning.fetch_sub(1);  // not on its way back: the callback must not wait for it
+#ifdef __GLIBCXX__
+    try {
+        PyEval_RestoreThread(state);
+    } catch (abi::__forced_unwind&) {
         for (;;) std::this_thread::sleep_for(std::chrono::hours(24));
     }
+#else
     PyEval_RestoreThread(state);
-    returning.fetch_sub(1);
+#endif
 }
 
 // Runs `f` with the GIL released, taken back by take_gil_back (never in a destructor).
@@ -364,7 +357,6 @@ PYBIND11_MODULE(cellrt, m) {
     using namespace cellrt::python;
     m.doc() = "cellrt: ray casting through the SAH kd-tree, BIH, wide BVH and Embree (docs/PYTHON.md)";
     m.attr("__version__") = CELLRT_VERSION_STRING;
-    py::module_::import("atexit").attr("register")(py::cpp_function(&at_interpreter_exit));
     static const py::exception<Error>& error_type = py::register_exception<Error>(m, "Error", PyExc_ValueError);
     error_type.attr("__doc__") = "What the library refuses (a file, a configuration, a camera), with its message naming "
                                  "the file and line, the field or the parameter at fault; a ValueError.";

@@ -12,11 +12,14 @@
 #include <csignal>
 #include <sys/stat.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -251,6 +254,23 @@ TEST(Render, APipeIsWaitedForUntilItsReaderComesOrASignal) {
     }
     ASSERT_EQ(::waitpid(writer, &status, 0), writer);
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    // A cancel flag already set (a signal before the wait began) ends it at once.
+    std::atomic<bool> cancel{true};
+    set_write_cancel(&cancel);
+    EXPECT_EQ(test::error_of([&] { write_file_atomically(fifo, "late\n", false); }),
+              fifo + ": interrupted while waiting for a reader of the pipe");
+    set_write_cancel(nullptr);
+    // A socket also answers ENXIO: refused, not waited for as a pipe (found by review, 2026-12-07).
+    const std::string socket_path = (dir / "s").string();
+    const int listener = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    ASSERT_GE(listener, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strncpy(address.sun_path, socket_path.c_str(), sizeof address.sun_path - 1);
+    ASSERT_EQ(::bind(listener, reinterpret_cast<const sockaddr*>(&address), sizeof address), 0);
+    EXPECT_EQ(test::error_of([&] { write_file_atomically(socket_path, "x\n", false); }),
+              socket_path + ": cannot be opened for writing (No such device or address)");
+    ::close(listener);
     std::filesystem::remove_all(dir);
 }
 

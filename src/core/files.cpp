@@ -24,6 +24,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+std::atomic<const std::atomic<bool>*> g_write_cancel{nullptr};
+
 // What `path` names once links are followed: a regular file, a folder, a stream (a device, a pipe, a
 // socket), or nothing. A path the system keeps under /dev or /proc that leads to a regular file this
 // process holds open for writing counts as a stream: /dev/stdout or /dev/fd/3 redirected to a log
@@ -49,18 +51,28 @@ std::FILE* own_stream(const std::string& path) {
 bool system_path(const std::string& path) { return path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0; }
 
 // Whether one of the process's descriptors is open for writing on the file `path` leads to (a shell's
-// `> log` or `3>> log`). Read through /proc/self/fd; without /proc, none is found.
+// `> log` or `3>> log`). The descriptors are listed by /proc/self/fd; without /proc (fdescfs' /dev/fd
+// has no such list), the first 1024 are asked.
 bool open_for_writing(const std::string& path) {
     struct stat named {};
     if (::stat(path.c_str(), &named) != 0) return false;
+    const auto writes_it = [&](int fd) {
+        struct stat st {};
+        if (::fstat(fd, &st) != 0 || st.st_dev != named.st_dev || st.st_ino != named.st_ino) return false;
+        const int flags = ::fcntl(fd, F_GETFL);
+        return flags >= 0 && (flags & O_ACCMODE) != O_RDONLY;
+    };
     std::error_code ec;
-    for (fs::directory_iterator it("/proc/self/fd", ec), end; !ec && it != end; it.increment(ec)) {
+    fs::directory_iterator it("/proc/self/fd", ec);
+    if (ec) {
+        for (int fd = 0; fd < 1024; ++fd)
+            if (writes_it(fd)) return true;
+        return false;
+    }
+    for (const fs::directory_iterator end; !ec && it != end; it.increment(ec)) {
         int fd = -1;
         const std::string name = it->path().filename().string();
-        if (std::from_chars(name.data(), name.data() + name.size(), fd).ec != std::errc{}) continue;
-        struct stat st {};
-        if (::fstat(fd, &st) != 0 || st.st_dev != named.st_dev || st.st_ino != named.st_ino) continue;
-        if (const int flags = ::fcntl(fd, F_GETFL); flags >= 0 && (flags & O_ACCMODE) != O_RDONLY) return true;
+        if (std::from_chars(name.data(), name.data() + name.size(), fd).ec == std::errc{} && writes_it(fd)) return true;
     }
     return false;
 }
@@ -113,9 +125,14 @@ void write_in_place(const std::string& path, std::string_view bytes) {
     while ((fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_NONBLOCK | O_CLOEXEC)) < 0) {
         const int error = errno;
         if (error == EINTR) continue;
-        if (error != ENXIO) throw Error(path + ": cannot be opened for writing (" + std::strerror(error) + ")");
+        // ENXIO is also a socket's, or a terminal's where there is none: only a pipe is waited for.
+        struct stat st {};
+        if (error != ENXIO || ::stat(path.c_str(), &st) != 0 || !S_ISFIFO(st.st_mode))
+            throw Error(path + ": cannot be opened for writing (" + std::strerror(error) + ")");
         const timespec step{0, 10'000'000};
-        if (::nanosleep(&step, nullptr) != 0) throw Error(path + ": interrupted while waiting for a reader of the pipe");
+        const std::atomic<bool>* cancel = g_write_cancel.load();
+        if ((cancel && cancel->load()) || ::nanosleep(&step, nullptr) != 0)
+            throw Error(path + ": interrupted while waiting for a reader of the pipe");
     }
     const auto failed = [&](int error) {
         ::close(fd);
@@ -141,6 +158,8 @@ void check_system_path(const std::string& path, Target kind) {
 }
 
 }  // namespace
+
+void set_write_cancel(const std::atomic<bool>* flag) { g_write_cancel.store(flag); }
 
 std::string lower_extension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();

@@ -2,6 +2,7 @@
 // user has unless asked.
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -12,11 +13,17 @@ namespace cellrt {
 // Writes `bytes` beside `path` under a temporary name and renames it into place, so an interrupted
 // write never leaves a partial file under `path`. Refuses to replace an existing file unless
 // `overwrite`, and a folder always. A link to a file is followed: the file is replaced, the link
-// kept. A device, a pipe or any path under /dev or /proc (/dev/null, /dev/stdout) is appended to in
-// place, never renamed over: it is not a file whose contents could be lost, and renaming over it
-// would replace the device node (or a log file that /dev/stdout leads to).
+// kept. A device, a pipe, a socket, and a path under /dev or /proc that leads to a file this process
+// holds open for writing (/dev/stdout redirected to a log) are appended to in place, never renamed
+// over: renaming would replace the device node or the log. Any other path under /dev or /proc that
+// leads to a regular file is that file. A pipe no process reads yet is waited for (set_write_cancel).
 // Throws cellrt::Error naming the path on any failure (missing directory, no permission, disk full).
 void write_file_atomically(const std::string& path, std::string_view bytes, bool overwrite);
+
+// A flag that ends the wait for a pipe's reader once it is true (the programs' interrupt flag, which
+// their signal handlers set): the wait also ends at a signal it sees, but one that came before it
+// began would be missed. Null (the default): the wait ends at a signal or a reader only.
+void set_write_cancel(const std::atomic<bool>* flag);
 
 // What a program checks before the work whose result goes to `path` (a command-line option's output,
 // whose flag is --overwrite): refuses an empty name, a folder, an existing file unless `overwrite`,

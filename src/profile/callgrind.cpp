@@ -34,10 +34,15 @@ std::string temp_folder() {
     std::error_code ec;
     const fs::path folder = fs::temp_directory_path(ec);
     if (!ec) return folder.string();
-    const char* tmpdir = std::getenv("TMPDIR");
-    throw Error(std::string("the temporary folder") +
-                (tmpdir ? " $TMPDIR '" + std::string(tmpdir) + "'" : std::string(" /tmp")) +
-                " is not a folder (" + ec.message() + "): set TMPDIR to one callgrind's runs can be made in");
+    // The first of the variables the standard library reads, as it reads them (libstdc++).
+    std::string named = " /tmp";
+    for (const char* variable : {"TMPDIR", "TMP", "TEMP", "TEMPDIR"})
+        if (const char* value = std::getenv(variable)) {
+            named = " $" + std::string(variable) + " '" + value + "'";
+            break;
+        }
+    throw Error("the temporary folder" + named + " is not a folder (" + ec.message() +
+                "): set TMPDIR to one callgrind's runs can be made in");
 }
 
 namespace {

@@ -31,9 +31,10 @@ struct CallgrindOptions {
 // valgrind's path if it is on PATH, else empty.
 std::string find_valgrind();
 
-// The folder callgrind's runs are made in: the system's temporary folder ($TMPDIR, else /tmp). Throws
-// cellrt::Error naming $TMPDIR and its value when it is not a folder (the error was the standard
-// library's "filesystem error: temp_directory_path: No such file or directory", after the work).
+// The folder callgrind's runs are made in: the system's temporary folder ($TMPDIR, $TMP, $TEMP or
+// $TEMPDIR, else /tmp). Throws cellrt::Error naming the variable that chose it and its value when it
+// is not a folder (the error was the standard library's "filesystem error: temp_directory_path: No
+// such file or directory", after the work).
 std::string temp_folder();
 
 // Runs `command` (program and arguments; no shell) under callgrind and returns the events it

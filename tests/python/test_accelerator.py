@@ -244,8 +244,8 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
     # Short calls in a loop: the thread took the GIL back as the interpreter finalized, which ended it
     # by pthread_exit; unwinding out of py::gil_scoped_release's destructor was std::terminate
     # (status 134; found by audit, 2026-12-07), and unwinding pybind11's frames without the GIL a
-    # segmentation fault in one run of three. Three threads: one that stops for the exit must not be
-    # counted as on its way back (the exit waited for it: a hang, found by the full test run).
+    # segmentation fault in one run of three. Three threads, under which a first fix (an atexit
+    # barrier) hung.
     code = ("import threading, time, numpy as np, cellrt\n"
             "tri = np.eye(3, dtype=np.float32)[None]\n"
             "acc = cellrt.Accelerator(tri)\n"
@@ -259,6 +259,30 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
     for _ in range(5):
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
+
+
+def test_an_atexit_callback_joins_a_thread_in_calls_and_a_forked_child_ends():
+    # A first fix of the exit (an atexit barrier) blocked the threads that an earlier atexit callback
+    # then joined, and hung forked children at exit (found by review, 2026-12-07).
+    code = ("import atexit, os, threading, time\n"
+            "done = threading.Event()\n"
+            "def work():\n"
+            "    import numpy as np, cellrt\n"
+            "    acc = cellrt.Accelerator(np.eye(3, dtype=np.float32)[None])\n"
+            "    o = np.zeros((8, 3), np.float32); d = np.ones((8, 3), np.float32)\n"
+            "    while not done.is_set():\n"
+            "        acc.intersect(o, d)\n"
+            "t = threading.Thread(target=work, daemon=True)\n"
+            "def stop():\n"
+            "    done.set(); t.join(); print('joined')\n"
+            "atexit.register(stop)\n"
+            "t.start(); time.sleep(0.3)\n"
+            "pid = os.fork()\n"
+            "if pid:  # the child ends as the parent does, through its atexit callbacks\n"
+            "    _, status = os.waitpid(pid, 0); print('child', os.waitstatus_to_exitcode(status))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("joined") == 2 and "child 0" in done.stdout, done.stdout
 
 
 def test_more_threads_than_cores_trace_without_a_word():
