@@ -58,7 +58,22 @@ py::array required(const py::array& a, const char* dtype, const std::string& nam
 
 FloatRows rows_of(const py::array& a, const std::string& name, std::size_t rows) {
     FloatRows r;
-    r.array = required(a, "float32", name);
+    r.source = a;
+    if (a.dtype().kind() == 'f' && a.dtype().itemsize() > 4) {
+        // numpy warns of the overflow of a value past float32 (a RuntimeWarning pointing into numpy),
+        // which non_finite_message names instead.
+        const py::object quiet = numpy().attr("errstate")(py::arg("over") = "ignore");
+        quiet.attr("__enter__")();
+        try {
+            r.array = required(a, "float32", name);
+        } catch (...) {
+            quiet.attr("__exit__")(py::none(), py::none(), py::none());
+            throw;
+        }
+        quiet.attr("__exit__")(py::none(), py::none(), py::none());
+    } else {
+        r.array = required(a, "float32", name);
+    }
     r.data = static_cast<const float*>(r.array.data());
     r.rows = rows;
     r.borrowed = r.array.data() == a.data();
@@ -72,6 +87,7 @@ std::string vec_text(const float* p) {
 
 bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
 
+
 // Hits name triangles by a uint32 index, kNoHit reserved for a miss.
 void check_triangle_count(std::size_t count, const std::string& name) {
     if (count >= kNoHit)
@@ -80,6 +96,16 @@ void check_triangle_count(std::size_t count, const std::string& name) {
 }
 
 }  // namespace
+
+std::string non_finite_message(const FloatRows& rows, const py::object& index, const std::string& label, const float* p) {
+    if (!rows.borrowed && rows.source.dtype().kind() == 'f') {
+        const py::object given = rows.source.attr("__getitem__")(index);
+        if (numpy().attr("isfinite")(given).attr("all")().cast<bool>())
+            return label + " = " + py::repr(given.attr("tolist")()).cast<std::string>() +
+                   " is beyond float32's range (about 3.4e38)";
+    }
+    return label + " = " + vec_text(p) + " is not finite";
+}
 
 bool passes_through(const py::error_already_set& e) {
     return e.matches(PyExc_MemoryError) || !e.matches(PyExc_Exception);
@@ -237,8 +263,8 @@ std::vector<Triangle> indexed_triangles(py::handle vertices, py::handle faces) {
     const FloatRows v = float_rows(va, "vertices");
     for (std::size_t i = 0; i < v.rows; ++i)
         if (!finite3(v.data + 3 * i))
-            throw py::value_error("vertices[" + std::to_string(i) + "] = " + vec_text(v.data + 3 * i) +
-                                  " is not finite");
+            throw py::value_error(
+                non_finite_message(v, py::int_(i), "vertices[" + std::to_string(i) + "]", v.data + 3 * i));
     // uint64 indices beyond int64 wrap to negative values, which the range check refuses.
     std::vector<std::int64_t> objects;
     py::array idx;
@@ -268,8 +294,8 @@ std::vector<Triangle> triangle_soup(py::handle triangles) {
         for (std::size_t c = 0; c < 3; ++c) {
             const float* p = r.data + 9 * t + 3 * c;
             if (!finite3(p))
-                throw py::value_error("triangles[" + std::to_string(t) + ", " + std::to_string(c) + "] = " +
-                                      vec_text(p) + " is not finite");
+                throw py::value_error(non_finite_message(
+                    r, py::make_tuple(t, c), "triangles[" + std::to_string(t) + ", " + std::to_string(c) + "]", p));
             (&tris[t].v0)[c] = Vec3{p[0], p[1], p[2]};
         }
     return tris;
@@ -279,9 +305,9 @@ Vec3 vec3_value(py::handle object, const std::string& name) {
     const py::array a = as_array(object, name);
     if (a.ndim() != 1 || a.shape(0) != 3) throw py::value_error(name + " must have shape (3,), got " + shape_of(a));
     check_real(a, name);
-    const py::array f = required(a, "float32", name);  // held: a converted copy lives as long as it
-    const float* p = static_cast<const float*>(f.data());
-    if (!finite3(p)) throw py::value_error(name + " = " + vec_text(p) + " is not finite");
+    const FloatRows f = rows_of(a, name, 1);  // held: a converted copy lives as long as it
+    const float* p = f.data;
+    if (!finite3(p)) throw py::value_error(non_finite_message(f, py::slice(py::none(), py::none(), py::none()), name, p));
     return Vec3{p[0], p[1], p[2]};
 }
 

@@ -23,7 +23,14 @@ struct FloatRows {
     const float* data = nullptr;
     std::size_t rows = 0;
     bool borrowed = false;
+    py::array source;  // the array as given, of which `array` may be a converted copy
 };
+
+// Why the float32 values `p` of `rows` at `index` (an int, or a tuple for triangles) are refused:
+// "LABEL = (inf, 0.0, 0.0) is not finite", or, where the values given were finite floats wider than
+// float32 whose copy overflowed, "LABEL = [1e+300, 0.0, 0.0] is beyond float32's range (about
+// 3.4e38)" (reported as an infinity until found by audit, 2026-12-07).
+std::string non_finite_message(const FloatRows& rows, const py::object& index, const std::string& label, const float* p);
 
 // `object` as an (N, columns) float array (integers and float64 converted to float32); `name` is the
 // argument's name for messages. Refuses another shape or a dtype that is not a real number; values

@@ -169,8 +169,13 @@ std::size_t occluded(const Accelerator& accel, const Team& team, const RayInput&
 
 std::string invalid_ray_message(const RayInput& in, std::size_t i) {
     const std::string at = "[" + std::to_string(i) + "]";
-    if (!finite3(in.origins.data + 3 * i)) return "origins" + at + " is not finite";
-    if (!finite3(in.directions.data + 3 * i)) return "directions" + at + " is not finite";
+    // The values are named only where they were finite as given (beyond float32's range).
+    const auto named = [&](const FloatRows& rows, const char* name) {
+        const std::string message = non_finite_message(rows, py::int_(i), name + at, rows.data + 3 * i);
+        return message.ends_with(" is not finite") ? name + at + " is not finite" : message;
+    };
+    if (!finite3(in.origins.data + 3 * i)) return named(in.origins, "origins");
+    if (!finite3(in.directions.data + 3 * i)) return named(in.directions, "directions");
     // A scalar bound was refused at once when NaN, so this one is an array's.
     return std::string(std::isnan(in.tnear.at(i)) ? "tnear" : "tfar") + at + " is NaN";
 }
