@@ -333,6 +333,27 @@ TEST_F(GltfTest, BadFilesAreRefusedNamingThePartAtFault) {
     cam["nodes"][0]["scale"] = {0, 0, 0};
     EXPECT_EQ(error(cam), "node 0: its transform leaves camera 0 without a view direction and an up vector");
     EXPECT_EQ(error(with("/nodes/0/camera", 2)), "node 0: camera 2 does not exist (the file has 0 cameras)");
+    // Integer fields written as floats or past int: tinygltf left the first at their defaults and
+    // wrapped the second (found by audit, 2026-12-07: `"scene": 1.0` loaded scene 0).
+    const std::string integer = ": it must be an integer in [0, 2147483647], written without a decimal point or "
+                                "exponent (this reader does not take 1.0 as 1)";
+    EXPECT_EQ(error(with("/scene", 0.0)), "scene is 0.0" + integer);
+    EXPECT_EQ(error(with("/nodes/0/mesh", 4294967296ull)), "nodes[0].mesh is 4294967296" + integer);
+    EXPECT_EQ(error(with("/bufferViews/0/byteOffset", 12.0)), "bufferViews[0].byteOffset is 12.0" + integer);
+    EXPECT_EQ(error(with("/accessors/0/byteOffset", -4)), "accessors[0].byteOffset is -4" + integer);
+    EXPECT_EQ(error(with("/meshes/0/primitives/0/attributes/POSITION", 0.0)),
+              "meshes[0].primitives[0].attributes.POSITION is 0.0" + integer);
+    EXPECT_EQ(error(with("/scenes/0/nodes", json::array({0.0}))), "scenes[0].nodes[0] is 0.0" + integer);
+    {
+        const std::string path = write("float.glb", glb(with("/meshes/0/primitives/0/indices", 1.0), quad_bytes()));
+        EXPECT_EQ(error_of([&] { load_gltf(path); }), path + ": meshes[0].primitives[0].indices is 1.0" + integer);
+    }
+    // A camera whose node mirrors it: the image would be flipped, and was shown unmirrored.
+    json mirrored = with("/nodes/0/camera", 0);
+    mirrored["cameras"] = json::parse(R"([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}])");
+    mirrored["nodes"][0]["scale"] = {-1, 1, 1};
+    EXPECT_EQ(error(mirrored), "node 0: its transform mirrors camera 0, which this reader cannot show (a camera here "
+                               "has a position, a view direction and an up vector)");
     // Below pi as a double, 180 degrees as the camera's float (found by audit, 2026-12-07).
     json wide = with("/nodes/0/camera", 0);
     wide["cameras"] = json::parse(R"([{"type": "perspective", "perspective": {"yfov": 3.141592653589, "znear": 0.1}}])");

@@ -13,6 +13,8 @@
 #include <limits>
 #include <numbers>
 
+#include <nlohmann/json.hpp>
+
 #include "cellrt/error.hpp"
 #include "core/files.hpp"
 #include "cellrt/loaders.hpp"
@@ -99,6 +101,7 @@ public:
 
     GltfScene read() {
         parse();
+        check_integer_fields();
         check_required_extensions();
         const std::vector<int>& roots = default_scene_nodes();
         collect_instances(roots);
@@ -209,6 +212,67 @@ private:
         }
     }
 
+    // The file's JSON: the .gltf itself, or a GLB's first chunk (glTF 2.0 section 4.4.3; parse()
+    // has checked the container).
+    nlohmann::json document() const {
+        const std::string bytes = detail::read_file(path_);
+        if (lower_extension(path_) != ".glb") return nlohmann::json::parse(bytes);
+        std::uint32_t length = 0;
+        std::memcpy(&length, bytes.data() + 12, sizeof length);
+        return nlohmann::json::parse(bytes.substr(20, length));
+    }
+
+    // tinygltf takes an optional integer only as a JSON integer: written `1.0` (an integer to JSON
+    // Schema) it was left at its default without a word, and an index of 2^32 wrapped (found by
+    // audit, 2026-12-07: `"scene": 1.0` loaded scene 0, a byteOffset of 12.0 read from 0, `"mesh":
+    // 4294967296` loaded mesh 0). Each field that places or picks triangles must be a JSON integer
+    // in [0, 2^31 - 1]; other fields change nothing this reader reads.
+    void check_integer_fields() const {
+        const nlohmann::json doc = document();
+        const auto check = [&](const nlohmann::json& value, const std::string& name) {
+            if (value.is_number_unsigned() && value.get<std::uint64_t>() <= std::numeric_limits<int>::max()) return;
+            if (value.is_number_integer() && value.get<std::int64_t>() >= 0 &&
+                value.get<std::int64_t>() <= std::numeric_limits<int>::max())
+                return;
+            fail(name + " is " + value.dump() + ": it must be an integer in [0, 2147483647], written without a "
+                 "decimal point or exponent (this reader does not take 1.0 as 1)");
+        };
+        const auto fields = [&](const nlohmann::json& object, const std::string& name,
+                                std::initializer_list<const char*> keys) {
+            if (!object.is_object()) return;
+            for (const char* key : keys)
+                if (const auto it = object.find(key); it != object.end()) check(*it, name + "." + key);
+        };
+        const auto each = [&](const nlohmann::json& object, const char* key, const auto& visit) {
+            if (!object.is_object()) return;
+            const auto it = object.find(key);
+            if (it == object.end() || !it->is_array()) return;
+            for (std::size_t i = 0; i < it->size(); ++i) visit((*it)[i], std::string(key) + "[" + std::to_string(i) + "]");
+        };
+        if (const auto it = doc.find("scene"); it != doc.end()) check(*it, "scene");
+        each(doc, "scenes", [&](const nlohmann::json& scene, const std::string& name) {
+            each(scene, "nodes", [&](const nlohmann::json& n, const std::string& item) { check(n, name + "." + item); });
+        });
+        each(doc, "nodes", [&](const nlohmann::json& node, const std::string& name) {
+            fields(node, name, {"camera", "mesh", "skin"});
+            each(node, "children", [&](const nlohmann::json& n, const std::string& item) { check(n, name + "." + item); });
+        });
+        each(doc, "meshes", [&](const nlohmann::json& mesh, const std::string& name) {
+            each(mesh, "primitives", [&](const nlohmann::json& p, const std::string& item) {
+                fields(p, name + "." + item, {"indices", "mode"});
+                if (const auto a = p.find("attributes"); a != p.end() && a->is_object())
+                    for (const auto& [key, value] : a->items()) check(value, name + "." + item + ".attributes." + key);
+            });
+        });
+        each(doc, "accessors", [&](const nlohmann::json& a, const std::string& name) {
+            fields(a, name, {"bufferView", "byteOffset", "componentType", "count"});
+        });
+        each(doc, "bufferViews", [&](const nlohmann::json& v, const std::string& name) {
+            fields(v, name, {"buffer", "byteOffset", "byteLength", "byteStride"});
+        });
+        each(doc, "buffers", [&](const nlohmann::json& b, const std::string& name) { fields(b, name, {"byteLength"}); });
+    }
+
     const std::vector<int>& default_scene_nodes() const {
         if (model_.scenes.empty()) fail("the file has no scene");
         const int s = model_.defaultScene < 0 ? 0 : model_.defaultScene;
@@ -316,6 +380,12 @@ private:
         if (!is_finite(cam.position) || !is_finite(forward) || !is_finite(up) || forward == Vec3{} ||
             cross(forward, up) == Vec3{})
             fail(node_name(node) + ": its transform leaves " + name + " without a view direction and an up vector");
+        // A mirroring transform flips the image left to right (the camera's +x is its right), which a
+        // camera of position, look-at and up cannot show: it gave the unmirrored view (found by audit,
+        // 2026-12-07).
+        if (const Vec3 right = apply(world, 1, 0, 0, 0); dot(cross(right, up), forward) > 0.f)
+            fail(node_name(node) + ": its transform mirrors " + name + ", which this reader cannot show (a camera "
+                 "here has a position, a view direction and an up vector)");
         cam.look_at = cam.position + normalize(forward);
         cam.up = normalize(up);
         cam.fov_y_deg = fov_y_deg;
