@@ -40,9 +40,10 @@ struct Record {
 };
 
 // The calling thread's latest error per device id (0: errors with no device). Ids are never reused,
-// so a record never outlives its meaning. A record that was read, of a device released since, says
-// nothing get_error would not say without it: such records are dropped whenever the map has doubled
-// since the last sweep, so that a program making a device per job does not grow without bound.
+// so a record never outlives its meaning. The records of devices released since, read or not, are
+// dropped whenever the map has doubled since the last sweep, so that a program making a device per
+// job does not grow without bound (unread ones were kept: a program that takes its errors through
+// the error function alone grew by about 140 bytes a device; found by audit, 2026-12-07).
 struct Records {
     std::unordered_map<std::uint64_t, Record> map;
     std::size_t sweep_at = 64;
@@ -67,7 +68,7 @@ void record(std::uint64_t device, cellrt_error code, const char* message) {
     r.message = message;
     if (all->map.size() < all->sweep_at) return;
     std::erase_if(all->map, [](const auto& entry) {
-        return entry.first != 0 && entry.second.code == CELLRT_SUCCESS && !table().find<Device>(entry.first);
+        return entry.first != 0 && !table().find<Device>(entry.first);
     });
     all->sweep_at = std::max<std::size_t>(64, 2 * all->map.size());
 }
@@ -293,8 +294,8 @@ cellrt_error cellrt_device_set_error_function(cellrt_device device, cellrt_error
 
 cellrt_error cellrt_device_get_error(cellrt_device device, const char** message) {
     // Records are kept by id, so a handle that was never live has none, and one released keeps the
-    // calling thread's last error recorded on it while it lived (a release too many is recorded
-    // under NULL: a dead handle has no device).
+    // calling thread's last error recorded on it while it lived, until a sweep of record() drops it
+    // (a release too many is recorded under NULL: a dead handle has no device).
     Records* all = records();
     const auto it = all ? all->map.find(id_of(device)) : decltype(all->map)::iterator{};
     if (!all || it == all->map.end()) {
