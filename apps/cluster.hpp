@@ -46,6 +46,8 @@ inline bool leader() { return rank() == 0; }  // prints, and writes the outputs
 void print_error(const std::exception& e);
 // The program's name, as start() was given it.
 const char* program();
+// Whether this is the MPI program (cellrt-mpi), at any rank count: its frames are cut into tiles.
+bool distributed();
 
 // Runs `step` on every process; when it throws on any, it throws on all, naming the first process at
 // fault and its cause (in the plain program: `step` itself).
@@ -201,7 +203,7 @@ inline int parse(CLI::App& app, int argc, char** argv) {
     }
     try {
         together([&] { if (!refused.empty()) throw Error(refused); }, "reading the command line");
-        agree(help ? "asked for --help" : "did not ask for --help", "comparing --help",
+        agree(help ? "asked for --help or --version" : "did not ask for --help or --version", "comparing --help",
               [](const std::string& mine, const std::string& leaders) {
                   return "it " + mine + ", rank 0 " + leaders.substr(0, leaders.find(" for"));
               });

@@ -18,6 +18,7 @@ int ranks() { return 1; }
 unsigned cores() { return std::max(1u, std::thread::hardware_concurrency()); }
 void print_error(const std::exception& e) { std::fprintf(stderr, "%s: error: %s\n", g_program, e.what()); }
 const char* program() { return g_program; }
+bool distributed() { return false; }
 void add_render_options(CLI::App&) {}
 void add_sweep_options(CLI::App&) {}
 void add_bench_options(CLI::App&) {}

@@ -406,9 +406,12 @@ Runner add_cache_study(CLI::App& app) {
             const Scene scene = cluster::load_scene(spec);
             // The results name their rows by the scene: two scenes of one name would be one in the
             // CSV, the table and the graphs.
-            if (const auto [at, fresh] = named.emplace(scene.name, spec); !fresh)
-                throw Error(spec + " and " + at->second + " are both the scene '" + scene.name +
-                            "', and the results name their rows by scene: give one view file another \"name\"");
+            // Agreed, so said once: every rank found it and printed it (found by audit, 2026-12-07).
+            cluster::together([&] {
+                if (const auto [at, fresh] = named.emplace(scene.name, spec); !fresh)
+                    throw Error(spec + " and " + at->second + " are both the scene '" + scene.name +
+                                "', and the results name their rows by scene: give one view file another \"name\"");
+            }, "naming the scenes");
             int width = scene.width, height = scene.height;
             FrameRays w;
             std::map<std::string, std::unique_ptr<LocalStoreAccelerator>> bases;
@@ -456,7 +459,10 @@ Runner add_cache_study(CLI::App& app) {
             const std::vector<Result> results = [&] {
                 const Cancellable cancellable;
                 std::vector<Result> r = gpu ? trace_all_device(scene, runs, w) : trace_shared(bases, runs, w, threads);
-                if (g_cancel) throw Error("cache study cancelled");  // during the last run or the gather
+                // During the last run or the gather, on any rank: agreed, so that every rank ends here
+                // (one rank alone throwing left the others in the next scene's collectives: MPI_ERR_TRUNCATE,
+                // or results written beside a "cancelled"; found by audit, 2026-12-07).
+                cluster::together([] { if (g_cancel) throw Error("cache study cancelled"); }, "finishing the runs");
                 return r;
             }();
             if (!cluster::leader()) continue;

@@ -211,8 +211,11 @@ Runner add_render(CLI::App& app) {
                 throw Error("--packet " + std::to_string(o->packet) + " must lie in [1, " + std::to_string(kMaxPacket) +
                             "]");
             local_store = o->local_store.config(o->packet);
-            if (o->local_store.enabled && cluster::ranks() > 1)
-                throw Error("--local-store models one process's workers: run it with cellrt, not under mpirun");
+            // At any rank count: one rank's tiles change the order of the packets, and so the caches'
+            // figures (found by audit, 2026-12-07: `-np 1` gave other figures without a word).
+            if (o->local_store.enabled && cluster::distributed())
+                throw Error("--local-store models one process's workers over the whole frame: run it with cellrt, not "
+                            "cellrt-mpi");
             // Every option that does not need the scene, before it is loaded.
             if (!o->size.empty()) parse_image_size("--size", o->size);
             try {

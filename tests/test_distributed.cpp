@@ -123,6 +123,9 @@ TEST_F(Distributed, FramesAreTheOneProcessFrameForEveryRankCount) {
             EXPECT_NE(report.find("\"busy_seconds\""), std::string::npos);
             EXPECT_NE(report.find("\"frame_seconds\""), std::string::npos) << report;
             EXPECT_NE(report.find("\"float\""), std::string::npos) << report;
+            // render's own time-out: cache-study's day, registered after it, was every command's
+            // (found by audit, 2026-12-07).
+            EXPECT_EQ(nlohmann::json::parse(report).at("rank_timeout_seconds").get<double>(), 120.0) << report;
             // Ranks on rank 0's machine (all here) write their pixels into its shared window.
             EXPECT_EQ(window_ranks(stats), ranks - 1) << report;
             // Every rank's threads listed in rank order, those of a rank that traced no tile too.
@@ -407,7 +410,7 @@ TEST_F(Distributed, RanksStartedWithOtherOptionsAreRefusedAtOnce) {
                    "it was started without --broadcast-scene, rank 0 with it");
     // --help on one rank only: its exit used to be paired with the others' first agreement.
     expect_failure(shell(mpirun(1) + render + " : -np 1 " + render + " --help", dir.path), out, "rank 1: ",
-                   "it asked for --help, rank 0 did not ask");
+                   "it asked for --help or --version, rank 0 did not ask");
     EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(50)) << "a rank waited out its time-out";
 }
 
@@ -416,6 +419,16 @@ TEST_F(Distributed, ABadOptionIsOneMessage) {
     expect_failure(shell(mpirun(3) + mpi + " render " + kScene + " --packet 0 -o " + out.string(), dir.path), out,
                    "rank 0: ", "--packet 0 must lie in [1, 256]");
     expect_failure(shell(mpirun(2) + mpi + " info " + kScene, dir.path), out, "rank 0: ", "info runs in one process");
+    // At one rank too (its tiles gave other cache figures without a word; found by audit, 2026-12-07).
+    expect_failure(shell(mpirun(1) + mpi + " render " + kScene + " --local-store -o " + out.string(), dir.path), out,
+                   "rank 0: ", "--local-store models one process's workers over the whole frame: run it with cellrt, "
+                   "not cellrt-mpi");
+    // Said once, not by every rank (2026-12-07).
+    const fs::path study = dir.path / "study";
+    expect_failure(shell(mpirun(2) + mpi + " cache-study 'builtin:spheres?tris=200' 'builtin:spheres?tris=300' --size "
+                         "32x32 --sample 4 --packet 4 --traversals branched --access sync --structures kd --sweeps node "
+                         "--out " + study.string(), dir.path),
+                   study, "rank 0: ", "builtin:spheres?tris=300 and builtin:spheres?tris=200 are both the scene 'spheres'");
     // The command line's own check, on every rank: not a time-out of NaN seconds.
     const Outcome nan = shell(mpirun(2) + mpi + " render " + kScene + " --rank-timeout nan -o " + out.string(), dir.path);
     EXPECT_NE(nan.status, 0);

@@ -37,7 +37,11 @@ distributed::Session& session() { return *g_session; }
 constexpr std::chrono::seconds kLongestRankTimeout{86400};
 
 void add_timeout_option(CLI::App& cmd, std::chrono::seconds fallback) {
-    session().set_timeout(fallback);
+    // The command's own default, set when its options are read (before --rank-timeout's value): set
+    // here, when the commands are registered, the last one's (cache-study's day) was every command's
+    // (found by audit, 2026-12-07: render's 120 s was a day). A bare command line is render's, the
+    // session's own default.
+    cmd.preparse_callback([fallback](std::size_t) { session().set_timeout(fallback); });
     cmd.add_option_function<double>(
            "--rank-timeout",
            // A NaN or an infinity never gets here: strict_numbers (cluster.hpp) refuses them first.
@@ -72,6 +76,7 @@ int ranks() { return session().size(); }
 unsigned cores() { return distributed::rank_threads(0); }
 
 const char* program() { return session().program().c_str(); }
+bool distributed() { return true; }
 
 void print_error(const std::exception& e) {
     if (dynamic_cast<const distributed::AgreedError*>(&e)) {
@@ -141,6 +146,7 @@ void render(const Scene& scene, const Accelerator& accel, const RenderOptions& o
     report["gather"] = g_options.gather;
     report["window_ranks"] = loads.empty() ? 0 : loads[0].window_writers;
     report["scene_from"] = g_options.broadcast_scene ? "broadcast" : "path";
+    report["rank_timeout_seconds"] = static_cast<double>(session().timeout().count()) / 1e3;
     report["ranks"] = nlohmann::json::array();
     for (std::size_t r = 0; r < loads.size(); ++r) {
         const distributed::RankLoad& l = loads[r];
