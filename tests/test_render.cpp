@@ -237,7 +237,14 @@ TEST(Render, APipeIsWaitedForUntilItsReaderComesOrASignal) {
         const std::string got{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
         ::_exit(got == bytes ? 0 : 5);
     }
-    write_file_atomically(fifo, bytes, false);
+    std::string failure;  // the reader is ended first, so that it does not wait for a writer for ever
+    try {
+        write_file_atomically(fifo, bytes, false);
+    } catch (const std::exception& e) {
+        failure = e.what();
+        ::kill(reader, SIGKILL);
+    }
+    EXPECT_EQ(failure, "");
     int status = 0;
     ASSERT_EQ(::waitpid(reader, &status, 0), reader);
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
