@@ -54,8 +54,10 @@ struct AccelConfig {
 };
 
 // A tree's build report (Mitsuba's build statistics): its shape, how often triangles are referenced,
-// and its SAH cost, the expected cost of a random ray that meets the root cell, in the kd-tree's
-// default cost units (so that the kd-tree's and the BIH's compare).
+// and its SAH cost, the expected cost of a random ray that meets the root cell, in the cost units of
+// the structure's table: the kd-tree's as built (K_T 15 and K_I 20 for single rays, K_T 45 for SIMD
+// packets, or what -P set), the BIH's always K_T 15 and K_I 20 (so that it compares with a kd-tree
+// built with those), the BVH's its own.
 struct TreeReport {
     std::size_t nodes = 0, inner_nodes = 0, leaves = 0, empty_leaves = 0;
     std::optional<std::size_t> empty_space_nodes;  // BIH: inner nodes that cut off empty space
