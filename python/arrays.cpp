@@ -97,14 +97,16 @@ void check_triangle_count(std::size_t count, const std::string& name) {
 
 }  // namespace
 
+std::optional<std::string> beyond_float32(const FloatRows& rows, const py::object& index, const std::string& label) {
+    if (rows.borrowed || rows.source.dtype().kind() != 'f') return std::nullopt;
+    const py::object given = rows.source.attr("__getitem__")(index);
+    if (!numpy().attr("isfinite")(given).attr("all")().cast<bool>()) return std::nullopt;
+    return label + " = " + py::repr(given.attr("tolist")()).cast<std::string>() +
+           " is beyond float32's range (about 3.4e38)";
+}
+
 std::string non_finite_message(const FloatRows& rows, const py::object& index, const std::string& label, const float* p) {
-    if (!rows.borrowed && rows.source.dtype().kind() == 'f') {
-        const py::object given = rows.source.attr("__getitem__")(index);
-        if (numpy().attr("isfinite")(given).attr("all")().cast<bool>())
-            return label + " = " + py::repr(given.attr("tolist")()).cast<std::string>() +
-                   " is beyond float32's range (about 3.4e38)";
-    }
-    return label + " = " + vec_text(p) + " is not finite";
+    return beyond_float32(rows, index, label).value_or(label + " = " + vec_text(p) + " is not finite");
 }
 
 bool passes_through(const py::error_already_set& e) {

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,10 +27,13 @@ struct FloatRows {
     py::array source;  // the array as given, of which `array` may be a converted copy
 };
 
-// Why the float32 values `p` of `rows` at `index` (an int, or a tuple for triangles) are refused:
-// "LABEL = (inf, 0.0, 0.0) is not finite", or, where the values given were finite floats wider than
-// float32 whose copy overflowed, "LABEL = [1e+300, 0.0, 0.0] is beyond float32's range (about
-// 3.4e38)" (reported as an infinity until found by audit, 2026-12-07).
+// Where the values of `rows` at `index` (an int, or a tuple for triangles) were finite floats wider
+// than float32 whose copy overflowed: "LABEL = [1e+300, 0.0, 0.0] is beyond float32's range (about
+// 3.4e38)" (reported as an infinity until found by audit, 2026-12-07); else nullopt.
+std::optional<std::string> beyond_float32(const FloatRows& rows, const py::object& index, const std::string& label);
+
+// Why the float32 values `p` of `rows` at `index` are refused: beyond_float32's message, else
+// "LABEL = (inf, 0.0, 0.0) is not finite".
 std::string non_finite_message(const FloatRows& rows, const py::object& index, const std::string& label, const float* p);
 
 // `object` as an (N, columns) float array (integers and float64 converted to float32); `name` is the

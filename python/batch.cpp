@@ -171,8 +171,7 @@ std::string invalid_ray_message(const RayInput& in, std::size_t i) {
     const std::string at = "[" + std::to_string(i) + "]";
     // The values are named only where they were finite as given (beyond float32's range).
     const auto named = [&](const FloatRows& rows, const char* name) {
-        const std::string message = non_finite_message(rows, py::int_(i), name + at, rows.data + 3 * i);
-        return message.ends_with(" is not finite") ? name + at + " is not finite" : message;
+        return beyond_float32(rows, py::int_(i), name + at).value_or(name + at + " is not finite");
     };
     if (!finite3(in.origins.data + 3 * i)) return named(in.origins, "origins");
     if (!finite3(in.directions.data + 3 * i)) return named(in.directions, "directions");

@@ -14,7 +14,6 @@
 #include <memory>
 #include <optional>
 #include <thread>
-#include <type_traits>
 
 #include "arrays.hpp"
 #include "batch.hpp"
@@ -57,29 +56,20 @@ void take_gil_back(PyThreadState* state) {
 #endif
 }
 
-// Runs `f` with the GIL released, taken back by take_gil_back (never in a destructor).
+// Runs `f` with the GIL released, taken back by take_gil_back (never in a destructor). Every caller
+// returns a value.
 template <class F>
 auto without_gil(F&& f) {
     PyThreadState* const state = PyEval_SaveThread();
-    if constexpr (std::is_void_v<decltype(f())>) {
-        try {
-            f();
-        } catch (...) {
-            take_gil_back(state);
-            throw;
-        }
+    std::optional<decltype(f())> result;
+    try {
+        result.emplace(f());
+    } catch (...) {
         take_gil_back(state);
-    } else {
-        std::optional<decltype(f())> result;
-        try {
-            result.emplace(f());
-        } catch (...) {
-            take_gil_back(state);
-            throw;
-        }
-        take_gil_back(state);
-        return std::move(*result);
+        throw;
     }
+    take_gil_back(state);
+    return std::move(*result);
 }
 
 }  // namespace

@@ -80,12 +80,15 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
     // taskset or a cpuset stays on the cores it was given (job j was pinned to the machine's core j,
     // outside the set, where the system refused it and the run went unpinned; found by audit,
     // 2026-12-07).
+    // Read only where threads are pinned or were: a free run after a free run changes nothing.
     cpu_set_t caller_affinity;
     CPU_ZERO(&caller_affinity);
-    pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
     std::vector<int> allowed;
-    for (int c = 0; c < CPU_SETSIZE; ++c)
-        if (CPU_ISSET(c, &caller_affinity)) allowed.push_back(c);
+    if (pin || pinned_) {
+        pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
+        for (int c = 0; c < CPU_SETSIZE; ++c)
+            if (CPU_ISSET(c, &caller_affinity)) allowed.push_back(c);
+    }
     set_affinity(pin, allowed);
     if (pin && !allowed.empty()) {
         cpu_set_t first;

@@ -226,6 +226,11 @@ def test_the_gil_is_released_while_tracing():
     assert max(gaps) < 0.5 * alone, (max(gaps), alone)
 
 
+def run_python(code, timeout):
+    """Runs `code` in a Python of its own: what happens at its exit is what these tests look at."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
+
+
 def test_the_interpreter_ends_while_a_daemon_thread_renders():
     # The render's worker team was a static whose destructor waited at exit for the run; the thread,
     # resumed in a finalized interpreter, then ended in std::terminate (status 134).
@@ -234,7 +239,7 @@ def test_the_interpreter_ends_while_a_daemon_thread_renders():
             "threading.Thread(target=cellrt.render, args=(scene,), daemon=True,\n"
             "                 kwargs=dict(size=(4096, 4096), shading='ao', ao_samples=16, threads=2)).start()\n"
             "time.sleep(0.3)\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    done = run_python(code, timeout=300)
     assert done.returncode == 0, done.stderr
 
 
@@ -257,7 +262,7 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
             "    threading.Thread(target=loop, daemon=True).start()\n"
             "time.sleep(0.2)\n")
     for _ in range(5):
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        done = run_python(code, timeout=120)
         assert done.returncode == 0, done.stderr
 
 
@@ -280,7 +285,7 @@ def test_an_atexit_callback_joins_a_thread_in_calls_and_a_forked_child_ends():
             "pid = os.fork()\n"
             "if pid:  # the child ends as the parent does, through its atexit callbacks\n"
             "    _, status = os.waitpid(pid, 0); print('child', os.waitstatus_to_exitcode(status))\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    done = run_python(code, timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("joined") == 2 and "child 0" in done.stdout, done.stdout
 
@@ -291,7 +296,7 @@ def test_more_threads_than_cores_trace_without_a_word():
             "a = cellrt.Accelerator(np.eye(3, dtype=np.float32)[None], threads=1024)\n"
             "o = np.random.default_rng(1).random((5000, 3)).astype(np.float32)\n"
             "a.intersect(o, o - 0.5); a.occluded(o, o - 0.5)\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    done = run_python(code, timeout=120)
     assert done.returncode == 0 and done.stderr == "", done.stderr
 
 
