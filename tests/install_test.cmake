@@ -1,7 +1,7 @@
 # Installs the build tree into a fresh prefix, then configures, builds and runs tests/consumer (C++,
 # cellrt::cellrt) and tests/consumer_c (C99, cellrt::cellrt_c; without TBB or CUDA to find) against it,
-# as users would.
-# Arguments: SOURCE, BUILD, WORK.
+# as users would; and builds tests/consumer_c/main.c once more without CMake, from `pkg-config cellrt_c`.
+# Arguments: SOURCE, BUILD, WORK, PKG_CONFIG (the program), CC (the C compiler).
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix RESULT_VARIABLE rc OUTPUT_QUIET)
 if(NOT rc EQUAL 0)
@@ -27,3 +27,29 @@ foreach(program consumer/app consumer_c/app_c)
     message(FATAL_ERROR "the user's program ${program} did not hit the scene or write its image")
   endif()
 endforeach()
+# Without CMake: the flags pkg-config gives for the installed cellrt_c.pc, from a prefix moved after
+# installing (the file names its paths relative to itself).
+file(RENAME ${WORK}/prefix ${WORK}/moved)
+file(GLOB_RECURSE pc_file ${WORK}/moved/*/cellrt_c.pc)
+if(NOT pc_file)
+  message(FATAL_ERROR "cmake --install wrote no cellrt_c.pc")
+endif()
+get_filename_component(pc_dir ${pc_file} DIRECTORY)
+set(ENV{PKG_CONFIG_PATH} ${pc_dir})
+execute_process(COMMAND ${PKG_CONFIG} --cflags --libs cellrt_c OUTPUT_VARIABLE flags
+                OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "pkg-config cellrt_c failed")
+endif()
+separate_arguments(flags UNIX_COMMAND "${flags}")
+execute_process(COMMAND ${CC} -std=c99 -Wall -Wextra -pedantic -Werror ${SOURCE}/tests/consumer_c/main.c ${flags}
+                        -o ${WORK}/app_c_pkgconfig RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "building tests/consumer_c/main.c with `pkg-config --cflags --libs cellrt_c` failed: ${flags}")
+endif()
+get_filename_component(lib_dir ${pc_dir} DIRECTORY)
+set(ENV{LD_LIBRARY_PATH} ${lib_dir})
+execute_process(COMMAND ${WORK}/app_c_pkgconfig RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the C program built from pkg-config's flags did not hit the triangle")
+endif()
