@@ -80,7 +80,7 @@ void print_row(const char* label, const std::string& render, const std::string& 
     std::printf("%-22s %18s %18s\n", label, render.c_str(), traversal.c_str());
 }
 
-void print_report(const profile::RegionCounts& c, const TraversalCounters& work) {
+void print_report(const profile::RegionCounts& c, const TraversalCounters& work, bool counts_work) {
     const profile::EventCounts& r = c.render;
     const profile::EventCounts& t = c.traversal;
     auto count = [](const std::optional<std::uint64_t>& v) { return v ? with_commas(*v) : std::string("n/a"); };
@@ -103,9 +103,11 @@ void print_report(const profile::RegionCounts& c, const TraversalCounters& work)
     print_row("  cycles", cycles_per_ray(r), cycles_per_ray(t));
     print_row("  mispredictions", fixed(per(r.mispredictions, work.rays), "%.3f"),
               fixed(per(t.mispredictions, work.rays), "%.3f"));
-    print_row("  nodes", "", fixed(per(work.nodes, work.rays), "%.2f"));
-    print_row("  leaves", "", fixed(per(work.leaves, work.rays), "%.2f"));
-    print_row("  triangles", "", fixed(per(work.triangles, work.rays), "%.2f"));
+    // Embree counts rays only (AccelStats::counts_work): its work reads n/a, not a measured zero.
+    auto work_per_ray = [&](std::uint64_t n) { return counts_work ? fixed(per(n, work.rays), "%.2f") : "n/a"; };
+    print_row("  nodes", "", work_per_ray(work.nodes));
+    print_row("  leaves", "", work_per_ray(work.leaves));
+    print_row("  triangles", "", work_per_ray(work.triangles));
 }
 
 nlohmann::json to_json(const profile::EventCounts& c, std::uint64_t rays) {
@@ -261,13 +263,16 @@ nlohmann::json profile_json(const Scene& scene, const ProfileOptions& o, const P
                         {"method", p.hardware ? "hardware" : "callgrind"},
                         {"native_render_cpu_seconds", p.native_seconds}};
     j["rays"] = {{"primary", p.work.primary_rays}, {"shadow", p.work.secondary_rays}, {"all", all.rays}};
-    j["work"] = {{"nodes", all.nodes},
-                 {"leaves", all.leaves},
-                 {"triangles", all.triangles},
-                 {"per_ray",
-                  {{"nodes", per(all.nodes, all.rays)},
-                   {"leaves", per(all.leaves, all.rays)},
-                   {"triangles", per(all.triangles, all.rays)}}}};
+    if (st.counts_work)
+        j["work"] = {{"nodes", all.nodes},
+                     {"leaves", all.leaves},
+                     {"triangles", all.triangles},
+                     {"per_ray",
+                      {{"nodes", per(all.nodes, all.rays)},
+                       {"leaves", per(all.leaves, all.rays)},
+                       {"triangles", per(all.triangles, all.rays)}}}};
+    else
+        j["work"] = nullptr;  // Embree counts rays only
     j["regions"] = {{"render", to_json(p.counts.render, all.rays)},
                     {"traversal", to_json(p.counts.traversal, all.rays)}};
     return j;
@@ -301,7 +306,7 @@ int run_profile(const ProfileOptions& o) {
     std::printf("rays                   %s primary + %s shadow = %s; native render %.4f s CPU (best of %d)\n",
                 with_commas(p.work.primary_rays).c_str(), with_commas(p.work.secondary_rays).c_str(),
                 with_commas(p.all.rays).c_str(), p.native_seconds, kTimedRenders);
-    print_report(p.counts, p.all);
+    print_report(p.counts, p.all, p.structure.counts_work);
     if (!o.json.empty()) write_file_atomically(o.json, json_report(profile_json(scene, o, p)), o.overwrite);
     return 0;
 }

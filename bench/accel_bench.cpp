@@ -202,6 +202,7 @@ struct Result {
     std::string routed;         // `auto`: the share of rays each path answered, per query (its "routed" setting)
     std::size_t differing = 0, differing_secondary = 0;  // answers that differ from the exact ones
     TraversalCounters primary_work, shadow_work;
+    bool counts_work = true;    // whether the work counters hold nodes, leaves and triangles (not Embree's)
 };
 
 // A configuration: its structure, its figures so far and its timed passes.
@@ -265,16 +266,17 @@ std::vector<Entry> build_configurations(const Scene& scene, const Options& o) {
 double per_ray(std::uint64_t n, const TraversalCounters& c) { return c.rays ? double(n) / double(c.rays) : 0.0; }
 
 // A pass's nodes, leaves and triangles per ray; "–" and null where the configuration counts none
-// (Embree): a zero there read as a measured zero (found by audit, 2026-12-07).
-std::string work_text(const TraversalCounters& c) {
-    if (!c.rays) return "–";
+// (Embree, AccelStats::counts_work) or traced no ray: a zero there read as a measured zero (found by
+// audit, 2026-12-07).
+std::string work_text(const TraversalCounters& c, bool counted) {
+    if (!counted || !c.rays) return "–";
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.1f / %.1f / %.1f", per_ray(c.nodes, c), per_ray(c.leaves, c), per_ray(c.triangles, c));
     return buf;
 }
 
-nlohmann::json work_json(const TraversalCounters& c) {
-    if (!c.rays) return nullptr;
+nlohmann::json work_json(const TraversalCounters& c, bool counted) {
+    if (!counted || !c.rays) return nullptr;
     return {{"nodes", per_ray(c.nodes, c)}, {"leaves", per_ray(c.leaves, c)}, {"triangles", per_ray(c.triangles, c)}};
 }
 
@@ -320,7 +322,9 @@ std::vector<Result> results_of(std::vector<Entry>& entries, const SceneRays& s) 
         Result& r = e.r;
         r.primary_s = median(e.primary_s);
         r.shadow_s = median(e.shadow_s);
-        r.routed = e.accel->stats().setting("routed").value_or("");  // the warm-up and timed passes
+        const AccelStats st = e.accel->stats();
+        r.routed = st.setting("routed").value_or("");  // the warm-up and timed passes
+        r.counts_work = st.counts_work;
         Answers primary, secondary;
         answer(*e.accel, s.rays.primary, RayKind::primary, s.rays.primary.size(), primary, &r.primary_work);
         answer(*e.accel, s.rays.secondary, s.rays.secondary_kind, s.rays.secondary.size(), secondary, &r.shadow_work);
@@ -366,7 +370,7 @@ void print_table(std::FILE* out, const std::vector<Result>& results, const Rays&
                      r.build_peak_mib, r.memory_mib, sah, np / r.primary_s * 1e-6, ns / r.shadow_s * 1e-6, total(r),
                      ratio(single, total(r), single ? total(*single) : 1).c_str(),
                      ratio(best, total(r), best ? total(*best) : 1).c_str(), r.differing + r.differing_secondary,
-                     work_text(pw).c_str(), work_text(sw).c_str());
+                     work_text(pw, r.counts_work).c_str(), work_text(sw, r.counts_work).c_str());
     }
 }
 
@@ -385,7 +389,7 @@ nlohmann::json json_row(const Scene& scene, int width, int height, const Options
             {"primary_rays", rays.primary.size()}, {"shadow_rays", rays.secondary.size()},
             {"primary_seconds", r.primary_s}, {"shadow_seconds", r.shadow_s},
             {"differing_primary_hits", r.differing}, {"differing_shadow_answers", r.differing_secondary},
-            {"primary_per_ray", work_json(pw)}, {"shadow_per_ray", work_json(sw)}};
+            {"primary_per_ray", work_json(pw, r.counts_work)}, {"shadow_per_ray", work_json(sw, r.counts_work)}};
     if (!r.routed.empty()) row["routed"] = r.routed;
     return row;
 }

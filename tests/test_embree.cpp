@@ -433,6 +433,9 @@ TEST(Embree, CountsRaysOnlyAndReportsItsBuild) {
     EXPECT_EQ(stats.setting("threads"), "1");
     EXPECT_EQ(stats.traversal, "single");
     EXPECT_EQ(stats.triangles, scene.triangles.size());
+    // Its zeros are not measured work: cellrt_bench prints "–" and cellrt profile "n/a" for them.
+    EXPECT_FALSE(stats.counts_work);
+    EXPECT_TRUE(make_accelerator(scene.triangles, {.kind = "kd"})->stats().counts_work);
 }
 
 TEST(Embree, RejectsBadParametersAndTraversals) {

@@ -78,6 +78,9 @@ struct AccelStats {
     std::size_t memory_bytes = 0;  // what the structure holds; not the triangles it reads in place
     std::size_t triangles = 0;
     std::optional<TreeReport> tree;  // kd-tree, BIH and the wide BVH
+    // Whether TraversalCounters' nodes, leaves and triangles are counted; false: rays only (Embree,
+    // which reports none), so that a zero there is not read as measured.
+    bool counts_work = true;
     // The build settings as used (name, value), in print order: the structure's parameters that shape
     // its build, Embree's flags, the local store's layout. Embree's also carry what it reports beside
     // its flags: its device's set-up time, its peak memory, the counters it keeps and its version.

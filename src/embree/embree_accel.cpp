@@ -239,6 +239,7 @@ public:
         s.build_cpu_seconds = build_cpu_seconds_;
         s.memory_bytes = memory_.live();
         s.triangles = triangle_count_;
+        s.counts_work = false;
         s.settings = {{"quality", options_.quality},
                       {"robust", options_.robust ? "true" : "false"},
                       {"compact", options_.compact ? "true" : "false"},
