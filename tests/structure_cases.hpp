@@ -53,6 +53,20 @@ inline std::vector<Triangle> soup(float scale) {
     return out;
 }
 
+// The unit soup beside triangles reaching +-3e38, where sums of coordinates overflow: the SAH BIH's
+// centres were infinite (a box's lo + hi at x = 3e38) and its bins' conversion of NaN crashed it
+// (bih@split=sah); and TA_rec's points at an end of the ray where the box's plane distance
+// overflowed were NaN, which chose children at random (kd:rec, on rays unbounded behind:
+// UnboundedBehind). Found by audit, 2026-12-07.
+inline std::vector<Triangle> soup_at_the_range_edge() {
+    std::vector<Triangle> out = soup(1.f);
+    const float f = 3e38f;
+    out.push_back({{f, f, f}, {-f, f, f}, {f, -f, -f}});
+    out.push_back({{-f, -f, -f}, {f, -f, f}, {f, f, -f}});
+    out.push_back({{f, 0.f, 0.f}, {f, 1.f, 0.f}, {f, 0.f, 1.f}});
+    return out;
+}
+
 inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_scenes() {
     std::vector<std::pair<std::string, std::vector<Triangle>>> out;
     const Triangle unit{{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
@@ -128,6 +142,7 @@ inline std::vector<std::pair<std::string, std::vector<Triangle>>> degenerate_sce
     out.push_back({"soup at 1e20", soup(1e20f)});
     out.push_back({"soup at 1e15", soup(1e15f)});
     out.push_back({"soup at 1e-17", soup(1e-17f)});
+    out.push_back({"soup beside triangles at +-3e38", soup_at_the_range_edge()});
     return out;
 }
 

@@ -77,7 +77,8 @@ INSTANTIATE_TEST_SUITE_P(Structures, DegenerateInputs, testing::ValuesIn(kConfig
 
 // The suite's rays unbounded behind their origins (tnear = -inf) over the soups whose T overflows
 // (1e15: t = -inf behind the origin along unit directions, with a normal determinant) or whose
-// determinant does (1e20): brute force's scalar test refuses a t that is not finite, and a SIMD
+// determinant does (1e20), and over the unit soup beside triangles at +-3e38
+// (soup_at_the_range_edge): brute force's scalar test refuses a t that is not finite, and a SIMD
 // kernel that leaves that to the query's bounds must find them finite (kernel/traversal.hpp,
 // finite_tnear; with it taken out, `bvh:wide` takes the t = -inf hits).
 class UnboundedBehind : public testing::TestWithParam<std::string> {};
@@ -90,9 +91,19 @@ TEST_P(UnboundedBehind, SameHits) {
     };
     static const std::vector<Case> cases = [] {
         std::vector<Case> out;
-        for (const auto& [name, scale] : {std::pair{"1e15", 1e15f}, std::pair{"1e20", 1e20f}}) {
-            std::vector<Triangle> tris = test::soup(scale);
+        for (const auto& [name, scale] : {std::pair{"1e15", 1e15f}, std::pair{"1e20", 1e20f}, std::pair{"1 beside +-3e38", 0.f}}) {
+            std::vector<Triangle> tris = scale == 0.f ? test::soup_at_the_range_edge() : test::soup(scale);
             std::vector<Ray> rays = test::RaySuite(tris, test::small_suite()).rays();
+            if (scale == 0.f) {
+                // Rays with a -0 component whose exit from the scene box overflows (the plane at 3e38
+                // over a component of 0.54), each through a soup triangle's centre 7 units behind its
+                // origin: TA_rec's exit point was inf * -0 = NaN there, and it missed them.
+                const Vec3 d{-0.f, 0.54f, 0.074f};
+                for (std::size_t i = 0; i < 50; ++i) {
+                    const Vec3 centre = (tris[i].v0 + tris[i].v1 + tris[i].v2) * (1.f / 3.f);
+                    rays.push_back(Ray{centre + d * 7.f, 0.f, d, kInfinity});
+                }
+            }
             for (Ray& r : rays) r.tnear = -kInfinity;
             test::ReferenceAnswers ref = test::compute_reference(tris, std::move(rays));
             out.push_back({name, std::move(tris), std::move(ref)});

@@ -110,8 +110,11 @@ struct Item {
 static_assert(sizeof(Item) == 28 && offsetof(Item, box.hi) == 12);
 
 // The SAH bin of a centre on each axis (kernel/box_lanes.hpp). The origin is the least centre of the
-// node, so the product is never negative.
-I4 bins_of(F4 centre, F4 origin, F4 scale) { return lane_bins(centre, origin, scale, F4{} + float(kSahBins - 1)); }
+// node, so the product is never negative; but it is NaN on an axis not binned (scale 0) whose centres
+// overflowed (coordinates past about 1.7e38: their sums, and the extent, are infinite), which the
+// guarded form puts in bin 0 (unguarded, its conversion gave a bin far out of range: a crash, found
+// by audit, 2026-12-07).
+I4 bins_of(F4 centre, F4 origin, F4 scale) { return lane_bins_guarded(centre, origin, scale, F4{} + float(kSahBins - 1)); }
 
 // The order in which a pass meets the triangles of a range: by ascending or descending position.
 enum class Order { ascending, descending };
@@ -461,14 +464,15 @@ private:
         const double cell_measure = measure(0, r.box.lo.x, r.box.hi.x);
         double best_cost = kInf, best_weight = kInf;
         int best_axis = -1, best_bin = 0;
-        // An axis with no extent, or too little to bin, is binned at scale 0 (all in bin 0) and skipped.
+        // An axis with no extent, too little to bin or an infinite one (centres past the floats' range),
+        // is binned at scale 0 (all in bin 0) and skipped.
         bool binned[3];
         F4 origin{}, scale{};
         for (int a = 0; a < 3; ++a) {
             const float extent = centres.hi[a] - centres.lo[a];
             origin[a] = centres.lo[a];
             scale[a] = kSahBins / extent;
-            binned[a] = extent > 0.f && std::isfinite(scale[a]);
+            binned[a] = extent > 0.f && extent < kInf && std::isfinite(scale[a]);
             if (!binned[a]) scale[a] = 0.f;
         }
         const Bins bins = bin(r, origin, scale);
