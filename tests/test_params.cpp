@@ -243,16 +243,22 @@ TEST(Params, AcceleratorSpecsSplitOrAreRefused) {
 }
 
 // A configuration written back is the canonical spec that parses to it: parts left out when absent
-// or "off", parameters by name. A repeated name, and an empty traversal or SIMD set, are refused.
+// or "off" (but "off" where it alone names a single-ray kernel: the CLI's and Python's bare "kd" is
+// the packets), parameters by name. A repeated name, and an empty traversal or SIMD set, are refused.
 TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
     for (const auto& [spec, canonical] : std::vector<std::pair<std::string, std::string>>{
-             {"kd", "kd"},
+             {"kd", "kd+off"},
              {"kd:rec", "kd:rec"},
-             {"kd+off", "kd"},
+             {"kd+off", "kd+off"},
+             {"kd:rec+off", "kd:rec"},
+             {"bih", "bih+off"},
+             {"brute", "brute+off"},
+             {"bvh", "bvh"},
+             {"embree", "embree"},
              {"bih+avx2", "bih+avx2"},
              {"kd:rec+avx2@leaf_size=2,bins=64", "kd:rec+avx2@bins=64,leaf_size=2"},
              {"auto@packets=bvh", "auto@packets=bvh"},
-             {"kd@note=a:b+c", "kd@note=a:b+c"}}) {
+             {"kd@note=a:b+c", "kd+off@note=a:b+c"}}) {
         const AccelConfig c = parse_accel_config(spec);
         EXPECT_EQ(format_accel_config(c), canonical) << spec;
         const AccelConfig back = parse_accel_config(format_accel_config(c));
@@ -264,7 +270,7 @@ TEST(Params, AcceleratorSpecsFormatBackToWhatTheyParseTo) {
     for (const char* bad : {"bvh@bins=8,bins=16", "kd:", "kd+", "kd:+sse"})
         EXPECT_THROW(parse_accel_config(bad), Error) << bad;
     EXPECT_EQ(format_accel_config(default_accel_config()), "auto@packets=bvh");
-    EXPECT_EQ(format_accel_config(default_accel_config("cuda")), "kd");
+    EXPECT_EQ(format_accel_config(default_accel_config("cuda")), "kd+off");
 }
 
 }  // namespace

@@ -45,7 +45,9 @@ bool names_replaced_traversal(const AccelConfig& config);
 AccelConfig parse_accel_config(std::string spec);
 
 // The configuration written as parse_accel_config reads it, in one canonical form: the traversal when
-// named, the SIMD set unless "off", the parameters sorted by name (e.g. "auto@packets=bvh"). The
+// named, the SIMD set unless "off" (written for kd, bih and brute without a traversal, "kd+off": there
+// it is what names their single-ray kernel, where the CLI's and Python's default is their packets),
+// the parameters sorted by name (e.g. "auto@packets=bvh"). The
 // threads and the device are not part of the string. parse_accel_config of the result gives back
 // `config`'s kind, traversal, SIMD set and parameters, where no parameter's value holds a ',' (no
 // structure accepts one).

@@ -194,7 +194,13 @@ AccelConfig parse_accel_config(std::string spec) {
 std::string format_accel_config(const AccelConfig& config) {
     std::string s = config.kind;
     if (!config.traversal.empty()) s += ":" + config.traversal;
-    if (config.simd != "off") s += "+" + config.simd;
+    // "off" is written where it is all that names the single-ray kernel of a structure that has SIMD
+    // packets too: a bare "kd" is the packets for the CLI and Python (their SIMD default is auto) and
+    // the single rays for the C API and the benchmarks, so "kd", copied from one to the other, built
+    // another tree (found by audit, 2026-12-07).
+    const bool off_names_the_kernel =
+        config.traversal.empty() && (config.kind == "kd" || config.kind == "bih" || config.kind == "brute");
+    if (config.simd != "off" || off_names_the_kernel) s += "+" + config.simd;
     char separator = '@';
     for (const auto& [name, value] : config.params) {
         s += separator + name + "=" + value;
