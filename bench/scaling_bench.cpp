@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <sstream>
@@ -52,6 +53,11 @@ struct Point {
     // Summed over workers, each the median over frames: time tracing packets, time from the frame's
     // start to each worker's start, time from each worker's finish to the frame's end.
     double busy_seconds, started_seconds, waiting_seconds;
+    // The same three as shares of workers x the frame, all of one round: the one whose frame time is
+    // the median (of an even count, the upper middle one), so that with the rest ("between packets")
+    // they make the whole. Shares of the medians above, taken over rounds apart, added up to 1.03
+    // (found by audit, 2026-12-07).
+    double tracing_share, waking_share, waiting_share;
     // Against the fewest workers, the median over rounds of each round's ratio: a shared machine's
     // speed drifts between rounds more than within one (its two frames are drawn back to back).
     double efficiency;         // t(first) first / (t(N) N)
@@ -62,7 +68,8 @@ struct Point {
     std::string routed;
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(Point, scene, config, dispatch, packet, workers, seconds, busy_seconds,
-                                   started_seconds, waiting_seconds, efficiency, packet_time_ratio, rays, routed)
+                                   started_seconds, waiting_seconds, tracing_share, waking_share, waiting_share,
+                                   efficiency, packet_time_ratio, rays, routed)
 
 // The median over rounds r of f(r).
 template <class F>
@@ -238,8 +245,16 @@ void add_points(const Timings& t, const std::string& scene, const std::string& c
         });
         const double packet_time_ratio =
             median_of_rounds(o.repeats, [&](std::size_t r) { return rounds.busy[r] / base.busy[r]; });
+        std::vector<std::size_t> order(rounds.seconds.size());
+        std::iota(order.begin(), order.end(), std::size_t{0});
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::size_t a, std::size_t b) { return rounds.seconds[a] < rounds.seconds[b]; });
+        const std::size_t m = order[order.size() / 2];
+        const double all = rounds.seconds[m] * w;
         points.push_back({scene, config, dispatch, packet, w, median(rounds.seconds), median(rounds.busy),
-                          median(rounds.started), median(rounds.waiting), efficiency, packet_time_ratio, t.rays, routed});
+                          median(rounds.started), median(rounds.waiting), rounds.busy[m] / all,
+                          rounds.started[m] / all, rounds.waiting[m] / all, efficiency, packet_time_ratio, t.rays,
+                          routed});
         std::fprintf(stderr, "%s %s %s %dx%d %u workers: %.4f s\n", scene.c_str(), config.c_str(), dispatch.c_str(),
                      packet, packet, w, points.back().seconds);
     }
@@ -365,9 +380,7 @@ void print_time_shares(const Study& study, const Options& o, const std::string& 
     for (const std::string& scene : study.scene_names) {
         const Point* last = find(study.points, scene, config, d, p, most);
         if (!last) continue;
-        const double all = last->seconds * most;
-        const double tracing = last->busy_seconds / all, waking = last->started_seconds / all,
-                     waiting = last->waiting_seconds / all;
+        const double tracing = last->tracing_share, waking = last->waking_share, waiting = last->waiting_share;
         std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f |\n", detail::markdown_cell(scene).c_str(), tracing, waking,
                     std::max(0.0, 1.0 - tracing - waking - waiting), waiting, last->packet_time_ratio);
     }
@@ -383,7 +396,9 @@ nlohmann::json points_json(const std::vector<Point>& points, const std::string& 
                          {"packet", pt.packet}, {"shading", to_string(shading.shading)},
                          {"workers", pt.workers}, {"seconds", pt.seconds},
                          {"busy_seconds", pt.busy_seconds}, {"started_seconds", pt.started_seconds},
-                         {"waiting_seconds", pt.waiting_seconds}, {"efficiency", pt.efficiency},
+                         {"waiting_seconds", pt.waiting_seconds}, {"tracing_share", pt.tracing_share},
+                         {"waking_share", pt.waking_share}, {"waiting_share", pt.waiting_share},
+                         {"efficiency", pt.efficiency},
                          {"packet_time_ratio", pt.packet_time_ratio}, {"rays", pt.rays}};
         if (shading.shading == Shading::ao) j["ao_samples"] = shading.ao_samples;
         if (!pt.routed.empty()) j["routed"] = pt.routed;

@@ -58,6 +58,20 @@ foreach(i RANGE ${last})
   string(JSON workers GET "${json}" ${i} workers)
   string(JSON shading GET "${json}" ${i} shading)
   string(JSON ao_samples GET "${json}" ${i} ao_samples)
+  # The time shares are of one round, so that they and the rest make the whole (shares of the parts'
+  # medians added up to 1.03): each in [0, 1], and the three leave a rest (between packets) of at
+  # least -0.001, the clocks' rounding.
+  foreach(share tracing_share waking_share waiting_share)
+    string(JSON ${share} GET "${json}" ${i} ${share})
+    if(${share} LESS 0 OR ${share} GREATER 1)
+      message(FATAL_ERROR "point ${i}: ${share} ${${share}} is not in [0, 1]")
+    endif()
+  endforeach()
+  execute_process(COMMAND ${PYTHON} -c "import sys; sys.exit(0 if ${tracing_share} + ${waking_share} + ${waiting_share} <= 1.001 else 1)"
+                  RESULT_VARIABLE over)
+  if(NOT over EQUAL 0)
+    message(FATAL_ERROR "point ${i}: shares ${tracing_share} + ${waking_share} + ${waiting_share} pass 1")
+  endif()
   if(NOT shading STREQUAL "ao" OR NOT ao_samples EQUAL 2)
     message(FATAL_ERROR "point ${i} records shading '${shading}' with ${ao_samples} AO samples, not ao with 2")
   endif()

@@ -288,8 +288,8 @@ TEST_F(DistributedBench, StructureSweepSplitOverRanksWritesTheOneProcessResults)
 TEST_F(DistributedBench, ScalingSweepSplitOverRanksWritesTheOneProcessResults) {
     expect_same_sweep(CELLRT_SCALING, CELLRT_SCALING_MPI,
                       sweep() + " --configs embree:single kd+auto --dispatch pull --packets 8 --workers 1 2 --repeats 1",
-                      {"seconds", "busy_seconds", "started_seconds", "waiting_seconds", "efficiency",
-                       "packet_time_ratio", "embree_seconds"},
+                      {"seconds", "busy_seconds", "started_seconds", "waiting_seconds", "tracing_share", "waking_share",
+                       "waiting_share", "efficiency", "packet_time_ratio", "embree_seconds"},
                       3 * 2 * (1 + embree_configs()), dir.path);
 }
 
