@@ -93,10 +93,17 @@ ShadingOptions parse_shading_options(const std::string& shading, int ao_samples,
 
 double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 
+// Whether the cache was read at all: a frame whose rays never read it (a camera looking away from the
+// scene) has no hit ratio, and 0 % would read as the worst (as cache-study writes it: found by audit,
+// 2026-12-07).
+bool was_read(const CacheStats& s) { return s.hits + s.misses > 0; }
+
 void print_cache(const char* name, const CacheLayout& layout, const CacheStats& s) {
-    std::printf("  %-15s %-9s %6.2f %% hits (%llu hits, %llu misses, %llu prefetches), %.2f MiB in, %llu evictions, "
+    char ratio[32] = "no reads";
+    if (was_read(s)) std::snprintf(ratio, sizeof ratio, "%.2f %% hits", 100.0 * s.hit_ratio());
+    std::printf("  %-15s %-9s %s (%llu hits, %llu misses, %llu prefetches), %.2f MiB in, %llu evictions, "
                 "%llu stale waits\n",
-                name, layout.to_string().c_str(), 100.0 * s.hit_ratio(), static_cast<unsigned long long>(s.hits),
+                name, layout.to_string().c_str(), ratio, static_cast<unsigned long long>(s.hits),
                 static_cast<unsigned long long>(s.misses), static_cast<unsigned long long>(s.prefetches), mib(s.bytes),
                 static_cast<unsigned long long>(s.evictions), static_cast<unsigned long long>(s.stale_waits));
 }
@@ -121,7 +128,8 @@ void print_local_store(const LocalStoreAccelerator& accel) {
 
 nlohmann::json cache_json(const CacheLayout& layout, const CacheStats& s) {
     return {{"layout", layout.to_string()}, {"line_bytes", layout.line_bytes}, {"sets", layout.sets},
-            {"ways", layout.ways},          {"hit_ratio", s.hit_ratio()},      {"hits", s.hits},
+            {"ways", layout.ways},          {"hit_ratio", was_read(s) ? nlohmann::json(s.hit_ratio()) : nlohmann::json()},
+            {"hits", s.hits},
             {"misses", s.misses},           {"prefetches", s.prefetches},      {"touch_hits", s.touch_hits},
             {"bytes", s.bytes},             {"evictions", s.evictions},        {"stale_waits", s.stale_waits}};
 }

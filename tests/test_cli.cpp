@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cellrt/accel.hpp"
 #include "cellrt/image.hpp"
 #include "cellrt/version.hpp"
 #include "profile/callgrind.hpp"
@@ -608,6 +609,31 @@ TEST(Cli, AccelTakesTheLibrarysConfigurationString) {
         EXPECT_NE(json.find("\"depth limit\": \"5\""), std::string::npos) << accel[1] << ": " << json;
         EXPECT_NE(json.find("\"simd lanes\": \"off\""), std::string::npos) << accel[1] << ": " << json;
     }
+    // The library's string for the single-ray kd-tree ("kd+off", format_accel_config) builds it here
+    // too, where a bare "kd" is the SIMD packets (--simd auto): "kd" built another tree (audit, 2026-12-07).
+    const std::string single = format_accel_config(parse_accel_config("kd"));
+    EXPECT_NE(figures({"--accel", single}).find("\"simd lanes\": \"off\""), std::string::npos) << single;
+    EXPECT_EQ(figures({"--accel", "kd"}).find("\"simd lanes\": \"off\""), std::string::npos);
+}
+
+// A local-store cache that no ray read (the camera looks away from the scene) has no hit ratio: "no
+// reads" and null, not 0 %, which would read as the worst (found by audit, 2026-12-07).
+TEST(Cli, ACacheNoRayReadHasNoHitRatio) {
+    TempDir dir;
+    std::ofstream(dir.path / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    std::ofstream(dir.path / "away.json")
+        << "{\"mesh\": \"tri.obj\", \"camera\": {\"position\": [0.5, 0.5, 3], \"look_at\": [0.5, 0.5, 6], "
+           "\"up\": [0, 1, 0], \"fov_y_deg\": 30}, \"light\": {\"position\": [0, 5, 5]}, "
+           "\"image\": {\"width\": 8, \"height\": 8}}\n";
+    const std::string stats = (dir.path / "stats.json").string();
+    const auto [text, status] =
+        run_for_error({"render", (dir.path / "away.json").string(), "--local-store", "--size", "8x8", "-o",
+                       (dir.path / "x.pfm").string(), "--stats", stats}, dir.path);
+    ASSERT_EQ(status, 0) << text;
+    const nlohmann::json j = nlohmann::json::parse(std::ifstream(stats));
+    const nlohmann::json& node = j.at("local_store").at("node_cache");
+    EXPECT_EQ(node.at("hits").get<int>() + node.at("misses").get<int>(), 0) << node;
+    EXPECT_TRUE(node.at("hit_ratio").is_null()) << node;
 }
 
 }  // namespace
