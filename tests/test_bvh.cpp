@@ -1097,6 +1097,13 @@ TEST_P(RoutedPaths, StreamedBatchesAnswerAsBruteForce) {
     }
 }
 
+// Before any ray, the route's report says so, not shares of 0 / 0 written as zeros (audit, 2026-12-07).
+TEST(Routed, ReportsNoneRoutedBeforeAnyRay) {
+    const std::vector<Triangle> tris = test::soup(1.f);
+    const auto routed = make_accelerator(tris, parse_accel_config("auto"));
+    EXPECT_EQ(routed->stats().setting("routed"), "closest none routed; any none routed");
+}
+
 INSTANTIATE_TEST_SUITE_P(Routed, RoutedPaths,
                          ::testing::Values(std::pair{std::string("auto"), std::vector<std::string>{"paired", "stream", "bvh-packets"}},
                                            std::pair{std::string("auto@packets=bvh"), std::vector<std::string>{"packets", "paired", "stream"}}),

@@ -134,9 +134,14 @@ private:
             for (int p = 0; p < count(); ++p)
                 sum += n[p] = static_cast<double>(routed_[q][p].load(std::memory_order_relaxed));
             out += q ? "; any" : "closest";
+            // No ray of the query yet: its shares are 0 / 0, not zeros (found by audit, 2026-12-07).
+            if (!(sum > 0.0)) {
+                out += " none routed";
+                continue;
+            }
             for (int p = 0; p < count(); ++p) {
                 char buf[48];
-                std::snprintf(buf, sizeof buf, " %s %.2f", paths_[p].name, sum > 0.0 ? n[p] / sum : 0.0);
+                std::snprintf(buf, sizeof buf, " %s %.2f", paths_[p].name, n[p] / sum);
                 out += buf;
             }
         }
@@ -144,11 +149,17 @@ private:
         for (int k = 0; k < 4; ++k) {
             const RoutePicker& picker = pickers_[k];
             if (picker.samples() == 0) continue;
+            // The mix the paths' costs are read at: the shares of the kind's rays hitting none, some or
+            // all of a batch, over the classes every timed path has; where no class is common to all,
+            // every share is 0 and the costs are plain times per ray, which the report says instead of
+            // printing zeros as shares (found by audit, 2026-12-07).
             const auto m = picker.mix();
-            char mix[64];
-            std::snprintf(mix, sizeof mix, "%.2f/%.2f/%.2f", m[0], m[1], m[2]);
-            out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) +
-                   " batches, rays hitting none/some/all " + mix + "), ns per ray";
+            char mix[96] = "plain times, no class of hit fraction timed on every path";
+            if (m[0] + m[1] + m[2] > 0.0)
+                std::snprintf(mix, sizeof mix, "costed at shares of rays hitting none/some/all %.2f/%.2f/%.2f", m[0],
+                              m[1], m[2]);
+            out += std::string("; timed ") + kKinds[k] + " (" + std::to_string(picker.samples()) + " batches, " + mix +
+                   "), ns per ray";
             for (int p = 0; p < count(); ++p) {
                 if (!picker.takes_part(p)) continue;
                 char buf[48];
