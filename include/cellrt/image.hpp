@@ -22,7 +22,8 @@ struct Image {
     const Vec3& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
-// Writes by extension: .png (sRGB-encoded, clamped) or .pfm (little-endian float RGB). The file is
+// Writes by extension: .png (sRGB-encoded, clamped, rows top to bottom) or .pfm (little-endian float
+// RGB, rows bottom to top as the PFM format stores them; read_pfm flips them back). The file is
 // written beside the target under a temporary name and renamed into place, so an interrupted write
 // never leaves a partial file under `path`. Refuses to replace an existing file unless `overwrite`.
 // Throws cellrt::Error naming the path on any failure, and for an image whose size check_image_size
