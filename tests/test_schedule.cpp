@@ -356,6 +356,38 @@ TEST(WorkerTeam, RunsEveryJobAtOnceOnKeptThreads) {
     }
 }
 
+// Free (unpinned) jobs run anywhere their caller may run, whoever started the team: its threads
+// inherited the cores of the thread that started them, and a team started from a thread confined to
+// one core kept every later caller's helpers there (found by audit, 2026-12-07).
+TEST(WorkerTeam, FreeJobsRunWhereTheirCallerMay) {
+    cpu_set_t all;
+    ASSERT_EQ(pthread_getaffinity_np(pthread_self(), sizeof all, &all), 0);
+    int last = -1;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &all)) last = c;
+    if (last <= 0) GTEST_SKIP() << "one core only: nothing to tell apart";
+    cpu_set_t only;
+    CPU_ZERO(&only);
+    CPU_SET(last, &only);
+    detail::WorkerTeam team;
+    // The helper's cores during a run of two jobs from a thread allowed `caller`.
+    auto helpers_cores = [&](const cpu_set_t& caller) {
+        cpu_set_t seen;
+        CPU_ZERO(&seen);
+        std::thread([&] {
+            pthread_setaffinity_np(pthread_self(), sizeof caller, &caller);
+            team.run(2, false, 0us, [&](unsigned j) {
+                if (j == 1) pthread_getaffinity_np(pthread_self(), sizeof seen, &seen);
+            });
+        }).join();
+        return seen;
+    };
+    const cpu_set_t first = helpers_cores(only), second = helpers_cores(all), third = helpers_cores(only);
+    EXPECT_TRUE(CPU_EQUAL(&first, &only));
+    EXPECT_TRUE(CPU_EQUAL(&second, &all)) << CPU_COUNT(&second) << " of " << CPU_COUNT(&all) << " cores";
+    EXPECT_TRUE(CPU_EQUAL(&third, &only));
+}
+
 // An exception from a job on a team thread reaches the caller once the other jobs are done (the first
 // thrown when several throw), and the team still runs.
 TEST(WorkerTeam, RethrowsAnExceptionFromAnyThread) {

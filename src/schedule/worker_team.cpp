@@ -80,15 +80,15 @@ void WorkerTeam::run(unsigned n, bool pin, std::chrono::microseconds spin, const
     // taskset or a cpuset stays on the cores it was given (job j was pinned to the machine's core j,
     // outside the set, where the system refused it and the run went unpinned; found by audit,
     // 2026-12-07).
-    // Read only where threads are pinned or were: a free run after a free run changes nothing.
+    // Read on every run, free ones too: threads inherit the affinity of the thread that starts them,
+    // and a team started by a render from a thread confined to one core kept every later free run's
+    // helpers on that core, whoever called (found by audit, 2026-12-07). One system call a run.
     cpu_set_t caller_affinity;
     CPU_ZERO(&caller_affinity);
     std::vector<int> allowed;
-    if (pin || pinned_) {
-        pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
-        for (int c = 0; c < CPU_SETSIZE; ++c)
-            if (CPU_ISSET(c, &caller_affinity)) allowed.push_back(c);
-    }
+    pthread_getaffinity_np(pthread_self(), sizeof caller_affinity, &caller_affinity);
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &caller_affinity)) allowed.push_back(c);
     set_affinity(pin, allowed);
     if (pin && !allowed.empty()) {
         cpu_set_t first;
@@ -151,11 +151,15 @@ void WorkerTeam::loop(unsigned t, Signal& signal) {
 
 void WorkerTeam::set_affinity(bool pin, const std::vector<int>& allowed) {
 #ifdef __linux__
-    // Pinned: thread t (job t + 1) on allowed[t + 1] (modulo their count). Free: every allowed core.
-    if ((!pin && !pinned_) || allowed.empty()) return;
+    // Pinned: thread t (job t + 1) on allowed[t + 1] (modulo their count). Free: every allowed core;
+    // a free run after a free run from a thread of the same cores, with no thread started since
+    // (which would have the starter's cores, the caller's), changes nothing.
+    if (allowed.empty()) return;
     cpu_set_t all;
     CPU_ZERO(&all);
     for (const int c : allowed) CPU_SET(c, &all);
+    const bool same_free_set = free_threads_ == threads_.size() && CPU_EQUAL(&all, &free_set_);
+    if (!pin && !pinned_ && same_free_set) return;
     for (unsigned t = 0; t < threads_.size(); ++t) {
         cpu_set_t set = all;
         if (pin) {
@@ -165,6 +169,8 @@ void WorkerTeam::set_affinity(bool pin, const std::vector<int>& allowed) {
         pthread_setaffinity_np(threads_[t].native_handle(), sizeof set, &set);
     }
     pinned_ = pin;
+    free_threads_ = pin ? 0 : threads_.size();
+    free_set_ = all;
 #else
     (void)pin;
     (void)allowed;

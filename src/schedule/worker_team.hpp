@@ -18,6 +18,10 @@
 // nothing cost the one-worker frame about 45 microseconds).
 #pragma once
 
+#ifdef __linux__
+#include <sched.h>
+#endif
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -65,6 +69,11 @@ private:
     std::vector<std::thread> threads_;
     std::vector<std::unique_ptr<Signal>> signals_;  // signals_[t]: thread t's; kept in place as the team grows
     bool pinned_ = false;
+#ifdef __linux__
+    // The cores the first free_threads_ threads were last set to run on, by a free run (0: none set).
+    cpu_set_t free_set_{};
+    std::size_t free_threads_ = 0;
+#endif
     // The current run, written by run() before it bumps the threads' signals, read by them after.
     const std::function<void(unsigned)>* job_ = nullptr;
     bool stopping_ = false;
