@@ -204,6 +204,10 @@ void Progress::finish() {
 void Progress::operator()(std::size_t done, std::size_t total) {
     if (!enabled_ || timer_.seconds() < 1.0) return;
     std::lock_guard lock(mutex_);
+    // The workers call at once and a later count may come first (found by audit, 2026-12-07): the bar
+    // never goes back, and the frame's last call need not be its largest.
+    if (done < drawn_) return;
+    drawn_ = done;
     const int width = 40, filled = static_cast<int>(width * done / total);
     std::fprintf(stderr, "\r[%s%s] %3zu%%", std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
                  100 * done / total);

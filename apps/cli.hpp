@@ -121,6 +121,7 @@ public:
 private:
     bool enabled_;
     bool shown_ = false;
+    std::size_t drawn_ = 0;  // the most packets drawn done: calls arrive out of order under pull dispatch
     Timer timer_;
     std::mutex mutex_;
 };

@@ -210,7 +210,9 @@ void bench_rays(const Scene& scene, const std::string& kind, const Options& o, c
                                       {"unfilled", c.unfilled},
                                       {"prefetches", c.prefetches},
                                       {"touch_hits", c.touch_hits},
-                                      {"hit_ratio", c.lookups() ? double(c.hits) / double(c.lookups()) : 0.0}};
+                                      // null, not 0, where no ray read the cache: 0 would read as the worst.
+                                      {"hit_ratio", c.lookups() ? nlohmann::json(double(c.hits) / double(c.lookups()))
+                                                                : nlohmann::json()}};
             };
             // Over every launch of this configuration on this scene, all ray sets together.
             const auto settings = gpu_accel->stats().settings;

@@ -5,7 +5,7 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(
   COMMAND ${SCALING} --scenes builtin:city?tris=3000 --configs kd+auto bih:branched auto --dispatch pull mailbox
-          --packets 8 --workers 1 2 --repeats 1 --size 40x24 --shading ao --ao-samples 2
+          --packets 8 --workers 1 2 --repeats 3 --size 40x24 --shading ao --ao-samples 2
           --json ${WORK}/scaling.json --csv ${WORK}/scaling.csv
   OUTPUT_VARIABLE tables ERROR_VARIABLE log RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)

@@ -27,7 +27,9 @@ struct RenderOptions {
     bool pin = false;      // pin worker threads to cores
     std::chrono::microseconds idle_spin = kDefaultIdleSpin;  // workers' poll before sleeping (schedule.hpp)
     bool count = false;    // collect traversal counters
-    // Called now and then with (packets done, packets in all).
+    // Called now and then with (packets done, packets in all): from the worker threads, several at
+    // once, under pull dispatch (from the master alone under mailbox), so it must be thread-safe; and
+    // the counts may arrive out of order (the last call need not be the largest): keep the largest.
     std::function<void(std::size_t, std::size_t)> progress;
     // Set to true (for example from a signal handler) to stop early; render() then throws.
     const std::atomic<bool>* cancel = nullptr;

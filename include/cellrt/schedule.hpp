@@ -71,7 +71,9 @@ struct ScheduleOptions {
     // drawn back to back do not pay a wake-up per worker (0: sleep at once; docs/SCALING.md).
     std::chrono::microseconds idle_spin{kDefaultIdleSpin};
     const std::atomic<bool>* cancel = nullptr;
-    // (packets done, packets in all). An exception it throws ends the frame as a packet's does.
+    // (packets done, packets in all). An exception it throws ends the frame as a packet's does. Called
+    // from the worker threads, several at once, under pull dispatch (from the master under mailbox):
+    // it must be thread-safe, and counts may arrive out of order (keep the largest).
     std::function<void(std::size_t, std::size_t)> progress;
 };
 

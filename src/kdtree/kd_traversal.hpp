@@ -118,14 +118,6 @@ struct KdRecPoint {
 static_assert(sizeof(KdRecPoint) == 40, "the local-store model budgets TA_rec's stack at 40 bytes a point");
 inline constexpr int kKdRecStackSize = kKdMaxDepth + 3;
 
-// The interval traversal for TA_rec's rays without a finite end, out of line: kd_traverse_rec is
-// flattened, and would otherwise take a second traversal's code into its own.
-template <class Tree, class Query, class Memory, class Counters>
-[[gnu::noinline]] CELLRT_NOINLINE CELLRT_HD bool kd_rec_unbounded(const Tree& tree, Memory& mem, const TraversalRay& r,
-                                                                  Query& q, Counters& c) {
-    return traverse_branched<KdTraits>(tree, mem, r, q, c);
-}
-
 // Flattened (every call inlined) on hosts: left to GCC's budget in the registry's unit, where every
 // tree's kernels are instantiated, the leaf test went in or out of line with changes to other
 // kernels, 8 % of TA_rec's instructions on Sponza's camera rays (docs/INCOHERENT.md).
@@ -137,10 +129,12 @@ template <class Tree, class Query, class Memory, class Counters>
     if (!r.clip(tree.bounds, tmin, tmax)) return false;
     // An end at infinity (the ray unbounded there, and the box's plane distance overflowed: a scene
     // reaching past 1.7e38 or so) has no point: inf times a zero component is NaN, and the planes'
-    // tests then chose children at random (found by audit, 2026-12-07). The interval traversal,
-    // whose tests are on t alone, takes such a ray.
-    if (!(tmin > -kInfinity && tmax < kInfinity)) [[unlikely]]
-        return kd_rec_unbounded(tree, mem, r, q, c);
+    // tests then chose children at random (found by audit, 2026-12-07). The largest finite t stands
+    // for it: a zero component then gives the origin's coordinate, a non-zero one +-inf, which every
+    // plane compares with rightly, and no hit's t, which is finite, lies beyond it. (A branch to the
+    // interval traversal instead cost the CUDA kernels some 900 bytes of stack a thread, and spills.)
+    tmin = finite_tnear(tmin);
+    tmax = finite_tfar(tmax);
     KdTraits::Leaves leaves;
     // Coordinates of points on the ray are exact to a few ulps of the largest coordinate involved
     // (KdRecKernel sends the rays for which this is 0 * inf elsewhere).

@@ -41,15 +41,11 @@ F4 lanes_centre(const Record& r) {
     return (lanes_lo(r) + lanes_hi(r)) * 0.5f;
 }
 
-// AxisBins::bin (kernel/binning.hpp) on each lane: (x - origin) * scale, at most `last`, truncated.
-// The same bins where x is not below the origin and the scale is finite (so the product is neither
-// negative nor NaN): the SAH BIH's centres against their least one.
-inline I4 lane_bins(F4 x, F4 origin, F4 scale, F4 last) {
-    const F4 k = (x - origin) * scale;
-    return __builtin_convertvector(last < k ? last : k, I4);
-}
-// The same bins as AxisBins::bin for every x and scale: where the product is not above 0 (NaN
-// included, as 0 times an infinite scale gives), bin 0.
+// AxisBins::bin (kernel/binning.hpp) on each lane: (x - origin) * scale, at most `last`, truncated,
+// the same bins for every x and scale: where the product is not above 0 (NaN included, as 0 times an
+// infinite scale or an infinite difference gives), bin 0. The SAH BIH's centres against their least
+// one (an infinite centre, of coordinates past 1.7e38, made a NaN there that an unguarded conversion
+// put far out of range: a crash).
 inline I4 lane_bins_guarded(F4 x, F4 origin, F4 scale, F4 last) {
     const F4 k = (x - origin) * scale;
     const F4 clamped = last < k ? last : k;
