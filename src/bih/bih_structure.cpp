@@ -31,7 +31,8 @@ const ParamTable& BihStructure::param_table() {
             {"intersection_cost", number, text(d.intersection_cost), 1e-6, 1e6, {},
              "`split=sah`: cost of a triangle test (the kd-tree's default)"},
             {"sah_max_leaf", integer, text(d.sah_max_leaf), 1, 1 << 20, {},
-             "`split=sah`: the largest leaf made when no split is cheaper; larger nodes take the cheapest split"},
+             "`split=sah`: the largest leaf made when no split is cheaper; larger nodes take the cheapest split "
+             "(nodes of `leaf_size` triangles or fewer are leaves first: at or below it, no effect)"},
         };
     }();
     return table;

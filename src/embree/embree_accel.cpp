@@ -460,7 +460,9 @@ const ParamTable& embree_params() {
     using enum ParamType;
     static const ParamTable table{
         {"quality", choice, "medium", 0, 0, {"low", "medium", "high"},
-         "Embree's RTC_BUILD_QUALITY_*: Morton build, SAH build, SAH build with spatial splits (Embree's default: medium)"},
+         "Embree's RTC_BUILD_QUALITY_*: Morton build, SAH build, SAH build with spatial splits (Embree's default: "
+         "medium; Embree makes spatial splits only with robust=false and compact=false, and builds `high` as "
+         "`medium` otherwise)"},
         {"robust", boolean, "true", 0, 0, {},
          "RTC_SCENE_FLAG_ROBUST: conservative box tests and Embree's watertight triangle test, the closest Embree comes "
          "to cellrt's hit rule"},

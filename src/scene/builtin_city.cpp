@@ -97,11 +97,13 @@ void make_city(Scene& scene, const BuiltinParams& p) {
     }
 
     // The camera stands in a street near the centre line, at the edge of a small city or six blocks
-    // out in a large one, and looks along it towards downtown.
+    // out in a large one, and looks along it towards downtown. A city of one block has no street
+    // through it (its one street is its edge, and the view along it looked away from the block: found
+    // by audit, 2026-12-07): the camera looks at the block.
     const float street_x = -half + static_cast<float>(grid / 2) * kPitch;  // centre line of a street
     const float distance = std::min(half + 0.5f * kPitch, 6.f * kPitch);
     scene.camera.position = {street_x + 3.f, 22.f, distance};
-    scene.camera.look_at = {street_x - 0.35f * distance, 16.f, 0.f};
+    scene.camera.look_at = {grid > 1 ? street_x - 0.35f * distance : 0.f, grid > 1 ? 16.f : 8.f, 0.f};
     scene.camera.up = {0.f, 1.f, 0.f};
     scene.camera.fov_y_deg = 60.f;
     // A high, sun-like light from behind the camera's left: lit facades, shadows across the streets.
