@@ -35,6 +35,7 @@ import subprocess
 import sys
 import tempfile
 
+import bench_outputs
 from bench_outputs import check_output
 
 ENTRY = re.compile(r"^[\w:<>, ]*::(intersect|occluded)\(std::span<cellrt::Ray const")
@@ -231,4 +232,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "ab_callgrind"))

@@ -16,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 
+import bench_outputs
 from bench_outputs import check_output
 
 
@@ -73,4 +74,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "ab_compare"))

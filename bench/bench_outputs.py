@@ -14,3 +14,22 @@ def check_output(parser, option, path, overwrite):
         parser.error(f"{option} {path}: is a folder")
     if os.path.exists(path) and not overwrite:
         parser.error(f"{option} {path}: file exists (pass --overwrite to replace it)")
+
+
+def run(main, name):
+    """Runs a script's main() and turns what a bad input raises (a file that is not there or not
+    readable, JSON that is not JSON, a file of another program or shape, a value that does not parse)
+    into one line, `NAME: error: ...`, and status 1, instead of a traceback (found by audit,
+    2026-12-07). main's own return value is the status."""
+    import json
+    import statistics
+    import sys
+    try:
+        return main()
+    except KeyError as e:
+        sys.exit(f"{name}: error: an input has no field {e} (is it the file this script reads?)")
+    except json.JSONDecodeError as e:
+        sys.exit(f"{name}: error: not JSON: {e}")
+    except (OSError, ValueError, TypeError, AttributeError, IndexError, ZeroDivisionError,
+            statistics.StatisticsError) as e:
+        sys.exit(f"{name}: error: {type(e).__name__}: {e}")

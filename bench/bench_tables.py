@@ -7,6 +7,7 @@ usage: bench/bench_tables.py bench.json [CONFIG ...]   (only the named configura
 """
 import json
 import sys
+import bench_outputs
 
 
 def total(r):
@@ -49,4 +50,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bench_outputs.run(main, "bench_tables"))

@@ -8,6 +8,7 @@ usage: bench/build_speed_table.py BEFORE.json AFTER.json   (several runs: BEFORE
 import json
 import statistics
 import sys
+import bench_outputs
 
 
 def load(arg):
@@ -66,4 +67,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bench_outputs.run(main, "build_speed_table"))

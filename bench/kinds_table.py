@@ -13,6 +13,7 @@ path answered) gets a second table of those shares.
 """
 import json
 import sys
+import bench_outputs
 
 
 def rate(r):
@@ -80,4 +81,4 @@ def main(argv) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(bench_outputs.run(lambda: main(sys.argv), "kinds_table"))

@@ -10,6 +10,8 @@ For each N the tile edge (of 256, 128, 64, 32, 16) that gives the shortest frame
 """
 import argparse
 import math
+import bench_outputs
+import sys
 
 
 def frame_time(n_nodes, a, edge):
@@ -68,4 +70,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "mpi_cost_model"))

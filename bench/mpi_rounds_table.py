@@ -16,6 +16,8 @@ import glob
 import json
 import os
 import statistics
+import bench_outputs
+import sys
 
 
 def load(path):
@@ -65,4 +67,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "mpi_rounds_table"))

@@ -11,7 +11,9 @@ per graph and scene:
 One line per number of sets: solid direct-mapped, dashed 4-way. Hit ratios are drawn for the
 branchless traversal (the branched one reads the same lines; docs/LOCALSTORE.md).
 
-usage: bench/plot_cache_study.py cache_study.csv OUTDIR
+usage: bench/plot_cache_study.py [--overwrite] cache_study.csv OUTDIR
+
+A graph already in OUTDIR is replaced only with --overwrite (the run stops at the first such file).
 """
 import csv
 import os
@@ -22,6 +24,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import bench_outputs
 
 GRAPHS = {  # (structure, sweep) -> graph numbers: hit ratio, time, async vs sync
     ("kd", "node"): ("5-1", "5-2", "5-5"),
@@ -57,8 +60,15 @@ def draw(ax, lines, ylabel, title):
     ax.grid(True, alpha=0.3)
 
 
+OVERWRITE = "--overwrite" in sys.argv
+if OVERWRITE:
+    sys.argv.remove("--overwrite")
+
+
 def save(fig, outdir, graph, scene, what):
     path = os.path.join(outdir, f"graph_{graph}_{scene}_{what}.png")
+    if os.path.exists(path) and not OVERWRITE:
+        raise ValueError(f"{path}: file exists (pass --overwrite to replace it)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -143,4 +153,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bench_outputs.run(main, "plot_cache_study"))

@@ -2,7 +2,10 @@
 """Draws the scaling curves of cellrt_scaling's JSON: per scene, seconds per frame and parallel
 efficiency against workers, one row per dispatch mode; colour = structure, line style = packet size.
 
-usage: bench/plot_scaling.py scaling.json [more.json ...] OUTDIR   (Debian's python3, python3-matplotlib)
+usage: bench/plot_scaling.py [--overwrite] scaling.json [more.json ...] OUTDIR   (Debian's python3,
+       python3-matplotlib)
+
+A figure already in OUTDIR is replaced only with --overwrite.
 
 Several runs are drawn together; a point that more than one of them measured is taken from the first.
 Runs of one scene must have measured the same frames (the shading, its AO samples and, within 1 %,
@@ -19,15 +22,19 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import bench_outputs
 
 STYLES = ["-", "--", ":", "-."]
 
 
 def main() -> int:
-    if len(sys.argv) < 3:
+    args = sys.argv[1:]
+    overwrite = "--overwrite" in args
+    args = [a for a in args if a != "--overwrite"]
+    if len(args) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    *inputs, outdir = sys.argv[1:]
+    *inputs, outdir = args
     seen = set()
     frames = {}  # scene -> (what its frames were, the file that said so)
     # scene -> dispatch -> (config, packet) -> [(workers, seconds, efficiency or None)]
@@ -51,6 +58,10 @@ def main() -> int:
                 data[p["scene"]][p["dispatch"]][(p["config"], p["packet"])].append(
                     (p["workers"], p["seconds"], p.get("efficiency")))
         os.makedirs(outdir, exist_ok=True)
+        for scene in data:
+            out = os.path.join(outdir, f"scaling_{scene}.png")
+            if os.path.exists(out) and not overwrite:
+                raise ValueError(f"{out}: file exists (pass --overwrite to replace it)")
     except (OSError, ValueError, KeyError, TypeError) as e:
         print(f"plot_scaling.py: error: {e if not isinstance(e, KeyError) else f'a point has no {e}'}",
               file=sys.stderr)
@@ -97,4 +108,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bench_outputs.run(main, "plot_scaling"))

@@ -4,7 +4,7 @@ Table 5-7), as Markdown tables for docs/PROFILE.md: runs `cellrt profile --json`
 the traversal alone, the whole render, and branchless against branched.
 
 usage: bench/profile_table.py [--cellrt build/cellrt] [--scenes ../shared/scenes]
-                              [--method auto|hardware|callgrind] [--size WxH] [--json-out FILE]
+                              [--method auto|hardware|callgrind] [--size WxH] [--json-out FILE [--overwrite]]
 """
 import argparse
 import json
@@ -12,6 +12,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import bench_outputs
 
 SCENES = ["sponza", "sibenik", "bunny", "teapot"]
 CONFIGS = [("kd", "rec"), ("kd", "branched"), ("kd", "branchless"), ("bih", "branched"), ("bih", "branchless")]
@@ -92,7 +93,10 @@ def main():
     p.add_argument("--method", default="auto", choices=["auto", "hardware", "callgrind"])
     p.add_argument("--size", help="image size WxH (default: cellrt profile's)")
     p.add_argument("--json-out", help="also write every profile's JSON, as one list, to this file")
+    p.add_argument("--overwrite", action="store_true", help="replace the --json-out file if it exists")
     args = p.parse_args()
+    if args.json_out:
+        bench_outputs.check_output(p, "--json-out", args.json_out, args.overwrite)
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -117,4 +121,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "profile_table"))

@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 import cellrt
+import bench_outputs
 
 
 def incoherent_rays(scene, count, seed=1):
@@ -97,4 +98,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "python_bench"))

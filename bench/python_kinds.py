@@ -18,8 +18,10 @@ import statistics
 import time
 
 import cellrt
+import bench_outputs
 from bench_outputs import check_output
 from python_bench import arguments, checked, incoherent_rays
+import sys
 
 
 def main():
@@ -95,4 +97,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "python_kinds"))

@@ -8,6 +8,7 @@ usage: bench/scaling_tables.py scaling.json [CONFIG ...]   (only the named confi
 """
 import json
 import sys
+import bench_outputs
 
 
 def main() -> int:
@@ -40,4 +41,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(bench_outputs.run(main, "scaling_tables"))

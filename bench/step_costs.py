@@ -49,6 +49,7 @@ import shutil
 import subprocess
 import sys
 import time
+import bench_outputs
 
 EVENTS = ["Ir", "Dr", "Dw", "I1mr", "D1mr", "D1mw", "ILmr", "DLmr", "DLmw", "Bc", "Bcm", "Bi", "Bim"]
 CATEGORIES = ["setup", "node", "leaf", "pop", "triangle", "batch", "other"]
@@ -590,6 +591,7 @@ def main():
     ap.add_argument("--LL", default="2097152,16,64", help="the simulated last level: by default this machine's L2")
     ap.add_argument("--work", default="/tmp/step_costs", help="finished runs, one JSON each")
     ap.add_argument("--json", help="write the study here")
+    ap.add_argument("--overwrite", action="store_true", help="replace the --json file if it exists")
     ap.add_argument("--tables", metavar="JSON", help="print the markdown tables of a written study and stop")
     ap.add_argument("--order", choices=["rays", "scenes"], default="rays",
                     help="rays: every configuration on one (ray kind, scene) before the next")
@@ -602,6 +604,7 @@ def main():
         return
     if not o.json:
         ap.error("--json is required")
+    bench_outputs.check_output(ap, "--json", o.json, o.overwrite)
     if not os.path.exists(o.bench):
         sys.exit(f"step_costs.py: error: no bench at {o.bench}")
     # Without line information every instruction would fall to "other", silently.
@@ -651,4 +654,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(bench_outputs.run(main, "step_costs"))
