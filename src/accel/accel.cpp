@@ -36,17 +36,21 @@ struct Entry {
     std::vector<std::string> traversals;
     LocalStoreFactory local_store = nullptr;  // trees only
     detail::DeviceFactory device = nullptr;   // trees only, where CUDA was found
+    // Whether SIMD "off" picks the single-ray kernels of a kind that has SIMD packets too (brute force
+    // and the trees), rather than standing for the best set (bvh, auto) or being only checked (embree).
+    bool off_is_single_rays = false;
 };
 
 std::vector<Entry> make_entries() {
-    std::vector<Entry> entries{{"brute", &make_brute_force, &brute_force_params(), brute_force_traversals()}};
+    std::vector<Entry> entries{{"brute", &make_brute_force, &brute_force_params(), brute_force_traversals(), nullptr,
+                                nullptr, true}};
     detail::TreeStructures::for_each([&]<class S>(std::type_identity<S>) {
         entries.push_back({S::kName,
                            [](std::span<const Triangle> triangles, const AccelConfig& config) -> std::unique_ptr<Accelerator> {
                                return std::make_unique<detail::TreeAccelerator<S>>(
                                    triangles, config, detail::packet_kernels_for(config));
                            },
-                           &S::param_table(), detail::names_of(S::kTraversals), &detail::make_model<S>});
+                           &S::param_table(), detail::names_of(S::kTraversals), &detail::make_model<S>, nullptr, true});
     });
     entries.push_back({"bvh",
                        [](std::span<const Triangle> triangles, const AccelConfig& config) {
@@ -198,8 +202,9 @@ std::string format_accel_config(const AccelConfig& config) {
     // packets too: a bare "kd" is the packets for the CLI and Python (their SIMD default is auto) and
     // the single rays for the C API and the benchmarks, so "kd", copied from one to the other, built
     // another tree (found by audit, 2026-12-07).
-    const bool off_names_the_kernel =
-        config.traversal.empty() && (config.kind == "kd" || config.kind == "bih" || config.kind == "brute");
+    const auto& all = entries();
+    const auto e = std::find_if(all.begin(), all.end(), [&](const Entry& x) { return x.kind == config.kind; });
+    const bool off_names_the_kernel = config.traversal.empty() && e != all.end() && e->off_is_single_rays;
     if (config.simd != "off" || off_names_the_kernel) s += "+" + config.simd;
     char separator = '@';
     for (const auto& [name, value] : config.params) {
