@@ -370,8 +370,11 @@ inline ReferenceAnswers stored_suite(std::span<const Triangle> tris, const RaySu
             if (ref.rays.size() < n || std::memcmp(ref.rays.data(), rays.data(), n * sizeof(Ray)) != 0) return false;
             const std::vector<Ray> limited =
                 first_limited(rays, std::vector<Hit>(ref.hits.begin(), ref.hits.begin() + n), kSuiteLimitedCount);
+            // memcmp of an empty vector's data() (null) is undefined, which UBSan reports: a suite
+            // may limit no ray (the soup beside triangles at +-3e38 limits none).
             return ref.rays.size() - n == limited.size() &&
-                   std::memcmp(ref.rays.data() + n, limited.data(), limited.size() * sizeof(Ray)) == 0;
+                   (limited.empty() ||
+                    std::memcmp(ref.rays.data() + n, limited.data(), limited.size() * sizeof(Ray)) == 0);
         });
 }
 
