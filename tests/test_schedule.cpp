@@ -212,18 +212,28 @@ TEST(Schedule, RejectsBadSettings) {
               "frame buffer does not match the packet grid");
 }
 
+// The highest core of `set` (-1: none), and a set of that one core: the affinity tests' one core apart.
+int last_core(const cpu_set_t& set) {
+    int last = -1;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &set)) last = c;
+    return last;
+}
+cpu_set_t just(int core) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(core, &set);
+    return set;
+}
+
 // Pinned workers stay on the cores the caller may use: under `taskset -c 1` they were pinned to core 0
 // and core 1 of the machine, or left unpinned where a cpuset refused (found by audit, 2026-12-07).
 TEST(Schedule, PinnedWorkersStayOnTheCallersCores) {
     cpu_set_t before;
     ASSERT_EQ(pthread_getaffinity_np(pthread_self(), sizeof before, &before), 0);
-    int last = -1;
-    for (int c = 0; c < CPU_SETSIZE; ++c)
-        if (CPU_ISSET(c, &before)) last = c;
+    const int last = last_core(before);
     if (last <= 0) GTEST_SKIP() << "one core only: nothing to tell apart";
-    cpu_set_t only;
-    CPU_ZERO(&only);
-    CPU_SET(last, &only);
+    const cpu_set_t only = just(last);
     ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof only, &only), 0);
     std::mutex m;
     std::set<int> cpus;
@@ -362,13 +372,9 @@ TEST(WorkerTeam, RunsEveryJobAtOnceOnKeptThreads) {
 TEST(WorkerTeam, FreeJobsRunWhereTheirCallerMay) {
     cpu_set_t all;
     ASSERT_EQ(pthread_getaffinity_np(pthread_self(), sizeof all, &all), 0);
-    int last = -1;
-    for (int c = 0; c < CPU_SETSIZE; ++c)
-        if (CPU_ISSET(c, &all)) last = c;
+    const int last = last_core(all);
     if (last <= 0) GTEST_SKIP() << "one core only: nothing to tell apart";
-    cpu_set_t only;
-    CPU_ZERO(&only);
-    CPU_SET(last, &only);
+    const cpu_set_t only = just(last);
     detail::WorkerTeam team;
     // The helper's cores during a run of two jobs from a thread allowed `caller`.
     auto helpers_cores = [&](const cpu_set_t& caller) {

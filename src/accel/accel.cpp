@@ -74,9 +74,15 @@ const std::vector<Entry>& entries() {
     return all;
 }
 
-const Entry& entry(const std::string& kind) {
+// The kind's entry, or nullptr.
+const Entry* find_entry(const std::string& kind) {
     for (const Entry& e : entries())
-        if (e.kind == kind) return e;
+        if (e.kind == kind) return &e;
+    return nullptr;
+}
+
+const Entry& entry(const std::string& kind) {
+    if (const Entry* e = find_entry(kind)) return *e;
     throw Error("unknown accelerator '" + kind + "' (choose one of: " + detail::join_names(accelerator_kinds()) + ")");
 }
 
@@ -202,9 +208,8 @@ std::string format_accel_config(const AccelConfig& config) {
     // packets too: a bare "kd" is the packets for the CLI and Python (their SIMD default is auto) and
     // the single rays for the C API and the benchmarks, so "kd", copied from one to the other, built
     // another tree (found by audit, 2026-12-07).
-    const auto& all = entries();
-    const auto e = std::find_if(all.begin(), all.end(), [&](const Entry& x) { return x.kind == config.kind; });
-    const bool off_names_the_kernel = config.traversal.empty() && e != all.end() && e->off_is_single_rays;
+    const Entry* e = find_entry(config.kind);
+    const bool off_names_the_kernel = config.traversal.empty() && e && e->off_is_single_rays;
     if (config.simd != "off" || off_names_the_kernel) s += "+" + config.simd;
     char separator = '@';
     for (const auto& [name, value] : config.params) {
