@@ -238,6 +238,91 @@ TEST_P(ScaledByPowersOfTwo, SameHits) {
 INSTANTIATE_TEST_SUITE_P(Structures, ScaledByPowersOfTwo, testing::ValuesIn(kConfigs),
                          [](const auto& info) { return name_of(info.param); });
 
+// Rays nearly parallel to triangles that lie in axis planes, aimed at their vertices along their
+// edges (found by audit, 2026-12-07): the refined t of such an ill-conditioned hit is the depth of
+// the triangle's point nearest the ray, within rounding of the ray in space, but the ray crosses the
+// plane by only its small direction component per unit of t, so that depth lay up to 3.5e-5
+// (relative) from the plane's, past a margin in t (2^-16 of the scene's reach), and every structure
+// culled a box or cell without thickness there that brute force's hit lies in. The margins of an
+// axis' planes are in space (kernel/traversal.hpp, axis_margin). One triangle of the audit, and
+// 6 x 6 grids in a plane of each axis (vertices at sixths); from either side of the plane, unbounded
+// and again limited at brute force's hits (RaySuite::limited: tfar at t and an ulp before, tnear at
+// t and an ulp after).
+class GrazingAxisPlanes : public testing::TestWithParam<std::string> {};
+
+TEST_P(GrazingAxisPlanes, SameHits) {
+    struct Case {
+        const char* name;
+        std::vector<Triangle> tris;
+        test::ReferenceAnswers ref;
+    };
+    static const std::vector<Case> cases = [] {
+        // A point of the plane of axis `a` at `level`, with in-plane coordinates (p, q).
+        const auto at = [](int a, float level, float p, float q) {
+            Vec3 v;
+            v[a] = level;
+            v[(a + 1) % 3] = p;
+            v[(a + 2) % 3] = q;
+            return v;
+        };
+        std::vector<Triangle> grids;
+        for (int a = 0; a < 3; ++a) {
+            const float level = a == 0 ? 0.f : (a == 1 ? 2.f / 3.f : -1.3f);
+            for (int i = 0; i < 6; ++i)
+                for (int j = 0; j < 6; ++j) {
+                    const float p0 = float(i) / 6.f, p1 = float(i + 1) / 6.f, q0 = float(j) / 6.f, q1 = float(j + 1) / 6.f;
+                    grids.push_back({at(a, level, p0, q0), at(a, level, p1, q0), at(a, level, p1, q1)});
+                    grids.push_back({at(a, level, p0, q0), at(a, level, p1, q1), at(a, level, p0, q1)});
+                }
+        }
+        std::uint32_t state = 2026;
+        const auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+        // Toward every vertex of every triangle along each of its two edges there (one way or the
+        // other, at random), with a component across the plane of 0.5 to 1.5 times 1e-2 to 1e-7 of
+        // the in-plane one, from either side.
+        const auto grazing_rays = [&](const std::vector<Triangle>& tris) {
+            std::vector<Ray> rays;
+            for (const Triangle& t : tris) {
+                const Vec3 v[3] = {t.v0, t.v1, t.v2};
+                const Vec3 n = cross(t.v1 - t.v0, t.v2 - t.v0);
+                const int a = std::fabs(n.x) > 0.f ? 0 : (std::fabs(n.y) > 0.f ? 1 : 2);
+                for (int k = 0; k < 3; ++k)
+                    for (int e = 1; e <= 2; ++e)
+                        for (const float across : {1e-2f, 1e-3f, 5.9e-5f, 1e-5f, 1e-6f, 1e-7f})
+                            for (const float side : {1.f, -1.f}) {
+                                const float way = next() < 0.5f ? 1.f : -1.f;
+                                Vec3 d = (v[(k + e) % 3] - v[k]) * way;
+                                d[a] = side * across * length(d) * (0.5f + next());
+                                const float reach = 0.5f + 2.f * next();
+                                rays.push_back(Ray{v[k] - d * reach, 0.f, d, kInfinity});
+                            }
+            }
+            return rays;
+        };
+        std::vector<Case> out;
+        const std::vector<Triangle> one = {{{0.f, 0.f, 0.f}, {0.f, 0.f, 1.f}, {0.f, 1.f, 1.f}}};
+        for (auto& [name, tris] : {std::pair{"one triangle in x = 0", one}, std::pair{"grids in three axis planes", grids}}) {
+            test::ReferenceAnswers ref = test::compute_reference(tris, grazing_rays(tris));
+            test::ReferenceAnswers lim = test::compute_reference(tris, test::RaySuite::limited(ref.rays, ref.hits));
+            ref.rays.insert(ref.rays.end(), lim.rays.begin(), lim.rays.end());
+            ref.hits.insert(ref.hits.end(), lim.hits.begin(), lim.hits.end());
+            ref.occluded.insert(ref.occluded.end(), lim.occluded.begin(), lim.occluded.end());
+            out.push_back({name, tris, std::move(ref)});
+        }
+        return out;
+    }();
+    for (const Case& c : cases) {
+        std::size_t hits = 0;
+        for (const Hit& h : c.ref.hits) hits += h.is_hit();
+        ASSERT_GT(hits, c.ref.hits.size() / 4) << "the rays must meet " << c.name;
+        test::expect_matches(*make_accelerator(c.tris, parse_accel_config(GetParam())), c.ref,
+                             GetParam() + " on " + c.name + ", grazing rays");
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Structures, GrazingAxisPlanes, testing::ValuesIn(kConfigs),
+                         [](const auto& info) { return name_of(info.param); });
+
 // A triangle some 1e-16 across, 1e-16 behind origins that look away from it along unit directions,
 // and a large one in front. The test's T, a length cubed, underflowed to zero and lost its sign: the
 // tiny triangle was hit at t = -0, which tnear = 0 admits, on every path and Embree's too (found by

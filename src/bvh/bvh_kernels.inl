@@ -2,9 +2,9 @@
 // (accel/kernels_<isa>.cpp) inside its target region, in a namespace of their own after
 // simd/lanes.inl with kLanes = 8: one lane per child of a node and per triangle of a leaf.
 //
-// A node: the ray's slab distances to the eight child boxes, widened by the ray's margin
+// A node: the ray's slab distances to the eight child boxes, widened by the ray's margins
 // (kernel/traversal.hpp) exactly as the scalar clip() widens the scene box, so that a box is missed
-// only when the ray passes it by more than the margin; the children met are visited nearest first
+// only when the ray passes it by more than its margin; the children met are visited nearest first
 // (an any-hit query: the first met), the others pushed with their entry distance and skipped when
 // popped past the query's cull distance.
 // A leaf: the watertight test (triangle.hpp) of its triangles, lane by lane in the scalar test's
@@ -25,22 +25,27 @@ typedef std::uint32_t URow __attribute__((vector_size(4 * kLanes), aligned(4), m
 inline F load(const float* p) { return *reinterpret_cast<const FRow*>(p); }
 inline U load_u(const std::uint32_t* p) { return *reinterpret_cast<const URow*>(p); }
 
-// The ray as the box tests of every node see it: its origin and reciprocal direction in all lanes,
-// its tnear and margin, and for each axis the offset (in floats, from the node's lo[0]) of the planes
-// it enters and leaves a box by, chosen once by the direction's sign.
+// The ray as the box tests of every node see it: its origin, reciprocal direction and each axis'
+// margin (axis_margins) in all lanes, its tnear less its margin, and for each axis the offset (in
+// floats, from the node's lo[0]) of the planes it enters and leaves a box by, chosen once by the
+// direction's sign.
 struct BoxRay {
-    F org[3], inv[3];
-    float tnear, margin;
+    F org[3], inv[3], margin[3];
+    float tmin;
     int enter[3], leave[3];
 
-    explicit BoxRay(const TraversalRay& r) : BoxRay(r.org, r.inv_dir, r.octant(), r.tnear, r.margin) {}
-    // From the origin and reciprocal direction (anything indexed by axis: a stream's stored ray,
-    // bvh_stream.inl, keeps them as floats) and the direction's sign bits.
-    template <class Origin, class Inverse>
-    BoxRay(const Origin& o, const Inverse& i, unsigned negative, float near, float m) : tnear(near), margin(m) {
+    explicit BoxRay(const TraversalRay& r)
+        : BoxRay(r.org, r.inv_dir, r.octant(), r.tnear, r.margin, r.axis_margin) {}
+    // From the origin, reciprocal direction and axis margins (anything indexed by axis: a stream's
+    // stored ray, bvh_stream.inl, keeps them as floats), the direction's sign bits, tnear and the
+    // margin in t.
+    template <class Origin, class Inverse, class Margins>
+    BoxRay(const Origin& o, const Inverse& i, unsigned negative, float near, float m, const Margins& axis)
+        : tmin(near - m) {
         for (int a = 0; a < 3; ++a) {
             org[a] = splat(o[a]);
             inv[a] = splat(i[a]);
+            margin[a] = splat(axis[a]);
             const int lo = a * kBvhWidth, hi = (3 + a) * kBvhWidth;
             enter[a] = negative >> a & 1 ? hi : lo;
             leave[a] = negative >> a & 1 ? lo : hi;
@@ -49,20 +54,18 @@ struct BoxRay {
 };
 
 // A node's children met by the ray within [tnear - margin, cull], as a lane mask, with each one's
-// entry distance. The scalar clip() widens every plane distance by the margin before it takes the
-// extremes; here the extremes are widened once: rounding is monotonic, so max(a - m, b - m) is
-// max(a, b) - m bit for bit, and the NaN-keeping max and min skip the same planes either way.
+// entry distance: the scalar clip()'s operations, each plane distance widened by its axis' margin
+// (a NaN one, of a ray lying in the plane, skipped by the NaN-keeping max and min).
 inline I meet_children_lanes(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
     static_assert(offsetof(BvhNode, hi) == 3 * kBvhWidth * sizeof(float), "hi follows lo");
     const float* planes = &node.lo[0][0];
-    F enter = splat(r.tnear), leave = splat(kInfinity);
+    F enter = splat(r.tmin), leave = splat(cull);
     for (int a = 0; a < 3; ++a) {
-        enter = max_keep(enter, (load(planes + r.enter[a]) - r.org[a]) * r.inv[a]);
-        leave = min_keep(leave, (load(planes + r.leave[a]) - r.org[a]) * r.inv[a]);
+        enter = max_keep(enter, (load(planes + r.enter[a]) - r.org[a]) * r.inv[a] - r.margin[a]);
+        leave = min_keep(leave, (load(planes + r.leave[a]) - r.org[a]) * r.inv[a] + r.margin[a]);
     }
-    const F margin = splat(r.margin);
-    entry = enter - margin;
-    return entry <= min_keep(splat(cull), leave + margin);
+    entry = enter;
+    return entry <= leave;
 }
 // The same as a bit mask.
 inline unsigned meet_children(const BvhNode& node, const BoxRay& r, float cull, F& entry) {
@@ -80,32 +83,34 @@ struct LeafRay {
     explicit LeafRay(const WatertightRay& r)
         : ox(splat(r.org[r.kx])), oy(splat(r.org[r.ky])), oz(splat(r.org[r.kz])), sx(splat(r.sx)), sy(splat(r.sy)),
           sz(splat(r.sz)), kx(r.kx * kBvhWidth), ky(r.ky * kBvhWidth), kz(r.kz * kBvhWidth) {}
-    // The same from a stream's stored ray: the origin already in the test's axis order (o), the
-    // shear (s) and the axes.
+    // The same from a stream's stored ray: the origin in the test's axis order (o), the shear (s)
+    // and the axes.
     LeafRay(const float* o, const float* s, int x, int y, int z)
         : ox(splat(o[0])), oy(splat(o[1])), oz(splat(o[2])), sx(splat(s[0])), sy(splat(s[1])), sz(splat(s[2])),
           kx(x * kBvhWidth), ky(y * kBvhWidth), kz(z * kBvhWidth) {}
 };
 
 // A ray as the node and leaf tests read it, in one cache line: the box test's origin, reciprocal
-// direction, tnear and margin, and the watertight test's origin in its axis order and shear.
+// direction, tnear, margin and axis margins, and the watertight test's shear and axes (its origin
+// is the box test's, read in its axis order).
 struct alignas(64) PreparedRay {
     float org[3], tnear;
     float inv[3], margin;
-    float leaf_org[3];  // the origin in the watertight test's axis order (kx, ky, kz)
-    float shear[3];     // sx, sy, sz
-    std::uint32_t code; // bits 0-2: the direction's sign bits (x, y, z); 3-4: kx; 5-6: ky; 7-8: kz
+    float axis_margin[3];  // kernel/traversal.hpp's axis_margins
+    float shear[3];        // sx, sy, sz
+    std::uint32_t code;    // bits 0-2: the direction's sign bits (x, y, z); 3-4: kx; 5-6: ky; 7-8: kz
     std::uint32_t unused;
 
     unsigned octant() const { return code & 7u; }
-    BoxRay box() const { return BoxRay(org, inv, code, tnear, margin); }
+    BoxRay box() const { return BoxRay(org, inv, code, tnear, margin, axis_margin); }
     LeafRay leaf() const {
-        return LeafRay(leaf_org, shear, static_cast<int>(code >> 3 & 3u), static_cast<int>(code >> 5 & 3u),
-                       static_cast<int>(code >> 7 & 3u));
+        const int x = static_cast<int>(code >> 3 & 3u), y = static_cast<int>(code >> 5 & 3u), z = static_cast<int>(code >> 7 & 3u);
+        const float o[3] = {org[x], org[y], org[z]};
+        return LeafRay(o, shear, x, y, z);
     }
 };
 static_assert(sizeof(PreparedRay) == 64, "a prepared ray is one cache line");
-static_assert(offsetof(PreparedRay, leaf_org) == 32, "prepare_rays writes a prepared ray as two rows of eight");
+static_assert(offsetof(PreparedRay, axis_margin) == 32, "prepare_rays writes a prepared ray as two rows of eight");
 
 // The node's child slots that hold a child (not kEmptyChild), as bits.
 inline unsigned node_children(const BvhNode& node) {
@@ -149,12 +154,13 @@ inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, 
     const WatertightLanes w(l);
     const I code = (l.negative[0] & 1) | (l.negative[1] & 2) | (l.negative[2] & 4) | w.kx << 3 | w.ky << 5 | w.kz << 7;
     F front[8] = {l.org[0], l.org[1], l.org[2], l.tnear, l.inv[0], l.inv[1], l.inv[2], l.margin};
-    F back[8] = {w.org[0], w.org[1], w.org[2], w.shear[0], w.shear[1], w.shear[2], reinterpret_cast<F>(code), splat(0.f)};
+    F back[8] = {l.axis_margin[0], l.axis_margin[1], l.axis_margin[2], w.shear[0], w.shear[1], w.shear[2],
+                 reinterpret_cast<F>(code), splat(0.f)};
     transpose8(front);
     transpose8(back);
     for (int i = 0; i < kLanes; ++i) {
         std::memcpy(&out[i], &front[i], sizeof(F));
-        std::memcpy(&out[i].leaf_org, &back[i], sizeof(F));
+        std::memcpy(&out[i].axis_margin, &back[i], sizeof(F));
     }
     return bits(l.valid);
 }

@@ -53,15 +53,15 @@ inline constexpr int kPacketSingleBelow = Query::kAnyHit ? 3 : 1;
 // The packet's rays that meet child `k` of `node` within [tnear - margin, cull], as lane bits, with
 // each one's entry distance: meet_children's test of that child, in every ray's lane.
 inline unsigned packet_meets(const BvhNode& node, int k, const RayLanes& p, F cull, F& entry) {
-    F enter = p.tnear, leave = splat(kInfinity);
+    F enter = p.tnear - p.margin, leave = cull;
     for (int a = 0; a < 3; ++a) {
         const F to_lo = (splat(node.lo[a][k]) - p.org[a]) * p.inv[a];
         const F to_hi = (splat(node.hi[a][k]) - p.org[a]) * p.inv[a];
-        enter = max_keep(enter, select(p.negative[a], to_hi, to_lo));
-        leave = min_keep(leave, select(p.negative[a], to_lo, to_hi));
+        enter = max_keep(enter, select(p.negative[a], to_hi, to_lo) - p.axis_margin[a]);
+        leave = min_keep(leave, select(p.negative[a], to_lo, to_hi) + p.axis_margin[a]);
     }
-    entry = enter - p.margin;
-    return bits_le(entry, min_keep(cull, leave + p.margin));
+    entry = enter;
+    return bits_le(entry, leave);
 }
 
 // A leaf's triangles against the packet's rays `rays`, one triangle at a time in every ray's lane (as
@@ -218,7 +218,8 @@ unsigned trace_packet(const BvhNode* nodes, const BvhLeaf* leaves, const RayLane
                 const float org[3] = {p.org[0][i], p.org[1][i], p.org[2][i]};
                 const float inv[3] = {p.inv[0][i], p.inv[1][i], p.inv[2][i]};
                 const unsigned octant = (p.negative[0][i] & 1u) | (p.negative[1][i] & 1u) << 1 | (p.negative[2][i] & 1u) << 2;
-                const BoxRay box(org, inv, octant, p.tnear[i], p.margin[i]);
+                const float axis[3] = {p.axis_margin[0][i], p.axis_margin[1][i], p.axis_margin[2][i]};
+                const BoxRay box(org, inv, octant, p.tnear[i], p.margin[i], axis);
                 if (traverse_bvh_from(nodes, leaves, box, leaf_ray(i), word, q[i], c)) active &= ~(1u << i);
                 if constexpr (!kAny) cull[i] = q[i].cull_t();
             }

@@ -94,7 +94,8 @@ struct KdTraits {
 // points with the split; only when the ray crosses the plane is its distance computed and a new
 // point pushed, which links to the exit point it replaces and names the far child that starts there.
 // A leaf's exit point is the next cell's entry. For robustness a point carries two positions: where
-// the near child is left (t + margin) and where the far child is entered (t - margin), and the
+// the near child is left (t plus the margin of the plane's axis) and where the far child is entered
+// (t minus it: kernel/traversal.hpp), and the
 // one-sided cases require both points to lie a coordinate margin clear of the plane.
 // Coordinates of a point without Vec3's zero initialisers: the stack's points are written before
 // they are read, and zeroing all of them cost each ray some 300 instructions.
@@ -170,8 +171,8 @@ template <class Tree, class Query, class Memory, class Counters>
                 int k = ex + 1;
                 if (k == en) ++k;
                 Point& pt = stack[k];
-                pt.t_exit = min_keep(stack[ex].t_exit, t + r.margin);
-                pt.t_entry = max_keep(stack[en].t_entry, t - r.margin);
+                pt.t_exit = min_keep(stack[ex].t_exit, t + r.axis_margin[a]);
+                pt.t_entry = max_keep(stack[en].t_entry, t - r.axis_margin[a]);
                 pt.exit = r.at(pt.t_exit);
                 pt.entry = r.at(pt.t_entry);
                 pt.far = near ^ 1u;

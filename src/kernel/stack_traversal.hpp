@@ -57,14 +57,15 @@ CELLRT_HD bool traverse_branched_from(Memory& mem, const TraversalRay& r, Query&
             const std::uint32_t s = (octant >> a) & 1u;
             const float t_near = (Traits::plane(n, s) - r.org[a]) * r.inv_dir[a];      // where the near child ends
             const float t_far = (Traits::plane(n, s ^ 1u) - r.org[a]) * r.inv_dir[a];  // where the far child begins
+            const float m = r.axis_margin[a];
             // A NaN distance (the ray lies in the plane) passes both tests: both children are visited.
-            const bool near_ok = !(tmin > t_near + r.margin), far_ok = !(t_far - r.margin > tmax);
+            const bool near_ok = !(tmin > t_near + m), far_ok = !(t_far - m > tmax);
             if (near_ok) {
-                if (far_ok) stack[sp++] = {n.children() + (s ^ 1u), max_keep(tmin, t_far - r.margin), tmax};
-                tmax = min_keep(tmax, t_near + r.margin);
+                if (far_ok) stack[sp++] = {n.children() + (s ^ 1u), max_keep(tmin, t_far - m), tmax};
+                tmax = min_keep(tmax, t_near + m);
                 index = n.children() + s;
             } else if (!Traits::kGaps || far_ok) {  // one plane: a ray not before it is after it
-                tmin = max_keep(tmin, t_far - r.margin);
+                tmin = max_keep(tmin, t_far - m);
                 index = n.children() + (s ^ 1u);
             } else {
                 reached_leaf = false;  // the ray passes between the two planes
@@ -108,10 +109,11 @@ CELLRT_HD bool traverse_branchless(const Tree& tree, Memory& mem, const Traversa
             const std::uint32_t s = (octant >> a) & 1u;
             const float t_near = (Traits::plane(n, s) - r.org[a]) * r.inv_dir[a];
             const float t_far = (Traits::plane(n, s ^ 1u) - r.org[a]) * r.inv_dir[a];
-            const bool near_ok = !(tmin > t_near + r.margin), far_ok = !(t_far - r.margin > tmax);
-            stack[sp] = {n.children() + (s ^ 1u), max_keep(tmin, t_far - r.margin), tmax};
+            const float m = r.axis_margin[a];
+            const bool near_ok = !(tmin > t_near + m), far_ok = !(t_far - m > tmax);
+            stack[sp] = {n.children() + (s ^ 1u), max_keep(tmin, t_far - m), tmax};
             sp += far_ok;
-            stack[sp] = {n.children() + s, tmin, min_keep(tmax, t_near + r.margin)};
+            stack[sp] = {n.children() + s, tmin, min_keep(tmax, t_near + m)};
             sp += near_ok;
             --sp;
             index = stack[sp].node;

@@ -9,6 +9,11 @@
 // it, and a cell is skipped after a hit only when it starts more than m beyond the best t. m bounds
 // the rounding error of both a plane distance and the watertight test's t for points inside the scene
 // box: it is a fixed fraction of the largest distance from the origin to the box, in units of t.
+// A plane of axis a is widened by more, m·|d|/|d_a| up to a factor √3 (axis_margins): the same
+// fraction in space, across the plane. An ill-conditioned hit's t (triangle.hpp, refined_t) is the depth of a point
+// within rounding of the ray in space, which on a ray nearly parallel to the plane can lie far in t
+// from where the ray crosses it: a triangle in an axis plane, in a box or cell of no thickness there,
+// was culled by a margin in t alone (found by audit, 2026-12-07: Structures/GrazingAxisPlanes).
 #pragma once
 
 #include <cmath>
@@ -72,11 +77,32 @@ CELLRT_HD inline bool direct_margin_holds(float m) { return m > 0.f && m < kInfi
     return traversal_margin_rescaled(reach, dir);
 }
 
+// The margins of the three axes' planes, in t, from the margin in t and the reciprocal direction:
+// spread · |1/d_a|, where the spread, the margin times √3 times the largest |d| (1 over the least
+// |1/d|), is at least the margin times |d| (to rounding, which the margin's slack of 2^8 covers), the
+// margin as a length along the ray; so a plane is widened in space by that length across it, and in
+// t by at least the margin. At most FLT_MAX (a zero component's, whose plane distances are infinite
+// or NaN, which no finite margin moves). The SIMD set-up (simd/ray_lanes.inl) takes the same
+// operations in the same order.
+inline constexpr float kSqrt3 = 0x1.bb67b0p+0f;  // √3 rounded up
+template <class Inverse>
+CELLRT_HD inline Vec3 axis_margins(float margin, const Inverse& inv) {
+    const float least = std::fmin(std::fabs(inv[0]), std::fmin(std::fabs(inv[1]), std::fabs(inv[2])));
+    const float spread = margin * kSqrt3 / least;
+    Vec3 m;
+    for (int a = 0; a < 3; ++a) {
+        const float x = spread * std::fabs(inv[a]);
+        m[a] = x < kLargestFloat ? (x > margin ? x : margin) : kLargestFloat;
+    }
+    return m;
+}
+
 struct TraversalRay {
     Vec3 org, dir, inv_dir;
     std::uint32_t dir_neg[3];  // 1 where the direction's sign bit is set (-0 included): the near child index
     float tnear, tfar;
-    float margin;
+    float margin;       // in t: of the ray's bounds and the queries' cull distance
+    Vec3 axis_margin;   // of each axis' planes (axis_margins)
     WatertightRay watertight;
 
     // Always inlined, with clip() and the triangle test (triangle.hpp): see intersect_unbounded.
@@ -87,6 +113,7 @@ struct TraversalRay {
             dir_neg[a] = std::signbit(dir[a]) ? 1u : 0u;
         }
         margin = traversal_margin(max(abs(scene_box.lo - org), abs(scene_box.hi - org)), dir);
+        axis_margin = axis_margins(margin, inv_dir);
     }
 
     CELLRT_HD Vec3 at(float t) const { return org + dir * t; }
@@ -97,7 +124,8 @@ struct TraversalRay {
     // on every step (about 10 % of a kd-tree's camera ray on Zen 4: docs/INCOHERENT.md, seventeenth round).
     CELLRT_HD std::uint32_t octant() const { return dir_neg[0] | dir_neg[1] << 1 | dir_neg[2] << 2; }
 
-    // The ray's interval [tnear, tfar] clipped to `box`, both widened by the margin. False when empty.
+    // The ray's interval [tnear, tfar] clipped to `box`, widened by the margin and each axis' planes
+    // by theirs. False when empty.
     // A slab the ray lies in exactly (origin on its face, zero direction on its axis) gives NaN and
     // does not cut the interval.
     [[gnu::always_inline]] CELLRT_HD bool clip(const Box3& box, float& tmin, float& tmax) const {
@@ -107,8 +135,8 @@ struct TraversalRay {
             const float t0 = (box.lo[a] - org[a]) * inv_dir[a];
             const float t1 = (box.hi[a] - org[a]) * inv_dir[a];
             const float enter = dir_neg[a] ? t1 : t0, leave = dir_neg[a] ? t0 : t1;
-            tmin = max_keep(tmin, enter - margin);
-            tmax = min_keep(tmax, leave + margin);
+            tmin = max_keep(tmin, enter - axis_margin[a]);
+            tmax = min_keep(tmax, leave + axis_margin[a]);
         }
         return tmin <= tmax;
     }

@@ -29,6 +29,7 @@ struct Lanes {
     F org[3], inv[3];
     I neg[3];       // the direction's sign bit per axis: the near child is the right one
     F tnear, tfar, margin;
+    F axis_margin[3];  // each axis' planes' (kernel/traversal.hpp, axis_margins)
     F sx, sy, sz;   // the watertight test's shear (WatertightRay)
     I perm;         // its axis permutation: 2 * kz + (kx and ky swapped)
     // The same permutation as lane masks, for SIMD packets whose lanes differ: role r (0: kx, 1: ky,
@@ -54,6 +55,7 @@ inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
         L.org[a] = R.org[a];
         L.inv[a] = R.inv[a];
         L.neg[a] = R.negative[a];
+        L.axis_margin[a] = R.axis_margin[a];
     }
     L.tnear = R.tnear;
     L.tfar = R.tfar;
@@ -77,7 +79,7 @@ inline Lanes load_lanes(const Ray* rays, int n, const Box3& scene_box) {
     return L;
 }
 
-// The lanes' intervals clipped to `box` and widened by the margin, as TraversalRay::clip does.
+// The lanes' intervals clipped to `box` and widened by the margins, as TraversalRay::clip does.
 inline I clip_lanes(const Lanes& L, const Box3& box, F& tmin, F& tmax) {
     tmin = L.tnear - L.margin;
     tmax = L.tfar + L.margin;
@@ -85,8 +87,8 @@ inline I clip_lanes(const Lanes& L, const Box3& box, F& tmin, F& tmax) {
         const F t0 = (splat(box.lo[a]) - L.org[a]) * L.inv[a];
         const F t1 = (splat(box.hi[a]) - L.org[a]) * L.inv[a];
         const F enter = select(L.neg[a], t1, t0), leave = select(L.neg[a], t0, t1);
-        tmin = max_keep(tmin, enter - L.margin);
-        tmax = min_keep(tmax, leave + L.margin);
+        tmin = max_keep(tmin, enter - L.axis_margin[a]);
+        tmax = min_keep(tmax, leave + L.axis_margin[a]);
     }
     return L.valid & (tmin <= tmax);
 }
@@ -222,17 +224,18 @@ inline bool right_first(I neg, I active) {
     return 2 * __builtin_popcount(bits(neg & active)) > __builtin_popcount(bits(active));
 }
 
-// The children's lane intervals at a plane crossed at t (per lane): the near child ends at t + m,
-// the far one starts at t - m; left/right by each lane's direction sign. Returns the active lanes of
-// each side.
+// The children's lane intervals at a plane of axis `a` crossed at t (per lane): the near child ends
+// at t + m, the far one starts at t - m, m that axis' margin; left/right by each lane's direction
+// sign. Returns the active lanes of each side.
 inline void split_lanes(const Lanes& L, int a, F t_left_ends, F t_right_starts, F tmin, F tmax, I active, F& lmin,
                         F& lmax, F& rmin, F& rmax, I& left, I& right) {
     // Positive direction: left is near (ends at t_left_ends), right is far (starts at t_right_starts).
     // Negative direction: right is near and ends at t_right_starts, left is far and starts at t_left_ends.
     const I neg = L.neg[a];
     const F near_end = select(neg, t_right_starts, t_left_ends), far_start = select(neg, t_left_ends, t_right_starts);
-    const I near_ok = ~(tmin > near_end + L.margin), far_ok = ~(far_start - L.margin > tmax);
-    const F near_max = min_keep(tmax, near_end + L.margin), far_min = max_keep(tmin, far_start - L.margin);
+    const F m = L.axis_margin[a];
+    const I near_ok = ~(tmin > near_end + m), far_ok = ~(far_start - m > tmax);
+    const F near_max = min_keep(tmax, near_end + m), far_min = max_keep(tmin, far_start - m);
     left = active & select(neg, far_ok, near_ok);
     right = active & select(neg, near_ok, far_ok);
     lmin = select(neg, far_min, tmin);
@@ -390,7 +393,7 @@ inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const L
     box = tree.bounds;
     const F inf = splat(kInfinity);
     F olo[3] = {inf, inf, inf}, ohi[3] = {-inf, -inf, -inf}, ilo[3] = {inf, inf, inf}, ihi[3] = {-inf, -inf, -inf};
-    F tmin_v = inf, tmax_v = -inf, margin_v = splat(0.f);
+    F tmin_v = inf, tmax_v = -inf, margin_v[3] = {splat(0.f), splat(0.f), splat(0.f)};
     I negative[3] = {splat_i(0), splat_i(0), splat_i(0)}, positive[3] = {splat_i(0), splat_i(0), splat_i(0)};
     for (const Lanes& g : simd_packets) {
         I loaded = splat_i(0);
@@ -406,10 +409,10 @@ inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const L
             ohi[a] = select(hit, max_keep(ohi[a], g.org[a]), ohi[a]);
             ilo[a] = select(hit, min_keep(ilo[a], g.inv[a]), ilo[a]);
             ihi[a] = select(hit, max_keep(ihi[a], g.inv[a]), ihi[a]);
+            margin_v[a] = select(hit, max_keep(margin_v[a], g.axis_margin[a]), margin_v[a]);
         }
         tmin_v = select(hit, min_keep(tmin_v, t0), tmin_v);
         tmax_v = select(hit, max_keep(tmax_v, t1), tmax_v);
-        margin_v = select(hit, max_keep(margin_v, g.margin), margin_v);
     }
     std::uint32_t signs = 0;
     Vec3 o_lo, o_hi, i_lo, i_hi;
@@ -419,7 +422,7 @@ inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const L
         o_lo[a] = min_of(olo[a]), o_hi[a] = max_of(ohi[a]), i_lo[a] = min_of(ilo[a]), i_hi[a] = max_of(ihi[a]);
     }
     float tmin = min_of(tmin_v), tmax = max_of(tmax_v);
-    const float margin = max_of(margin_v);
+    const float margin[3] = {max_of(margin_v[0]), max_of(margin_v[1]), max_of(margin_v[2])};
     if (!(tmin <= tmax)) return 0;
     std::uint32_t index = 0;
     for (;;) {
@@ -441,13 +444,13 @@ inline std::uint32_t entry_point(const TreeView<Traits>& tree, std::span<const L
         const bool negative_dir = (signs >> a) & 1u;
         // Near child ends at its plane, far child starts at its plane (as in split_lanes).
         const float near_end_hi = negative_dir ? r_hi : l_hi, far_start_lo = negative_dir ? l_lo : r_lo;
-        const bool near_needed = !(tmin > near_end_hi + margin), far_needed = !(far_start_lo - margin > tmax);
+        const bool near_needed = !(tmin > near_end_hi + margin[a]), far_needed = !(far_start_lo - margin[a] > tmax);
         if (near_needed == far_needed) return index;  // the batch splits here (or passes between planes)
         const bool left = negative_dir ? far_needed : near_needed;
         const float plane = Traits::plane(n, left ? 0u : 1u);
         if (left) box.hi[a] = std::min(box.hi[a], plane);
         else box.lo[a] = std::max(box.lo[a], plane);
-        if (far_needed) tmin = std::max(tmin, far_start_lo - margin);
+        if (far_needed) tmin = std::max(tmin, far_start_lo - margin[a]);
         index = n.children() + (left ? 0u : 1u);
     }
 }

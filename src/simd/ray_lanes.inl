@@ -112,6 +112,7 @@ struct RayLanes {
     F org[3], dir[3], inv[3];
     I negative[3];  // the direction's sign bit per axis, -0 included (std::signbit): enters by the hi plane
     F tnear, tfar, margin;
+    F axis_margin[3];  // kernel/traversal.hpp's axis_margins
     I valid;
 };
 
@@ -161,6 +162,13 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
             if (!direct[i])
                 L.margin[i] = traversal_margin_rescaled({reach[0][i], reach[1][i], reach[2][i]},
                                                         {L.dir[0][i], L.dir[1][i], L.dir[2][i]});
+    // axis_margins, lane by lane in its operations and order.
+    const F least_inv = min_lanes(abs_lanes(L.inv[0]), min_lanes(abs_lanes(L.inv[1]), abs_lanes(L.inv[2])));
+    const F spread = L.margin * splat(kSqrt3) / least_inv;
+    for (int a = 0; a < 3; ++a) {
+        const F x = spread * abs_lanes(L.inv[a]);
+        L.axis_margin[a] = select(x < splat(kLargestFloat), select(x > L.margin, x, L.margin), splat(kLargestFloat));
+    }
     return L;
 }
 
