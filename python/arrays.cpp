@@ -3,8 +3,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string_view>
 
 #include "cellrt/ray.hpp"
+#include "interpreter_exit.hpp"
 
 namespace cellrt::python {
 namespace {
@@ -21,14 +23,15 @@ py::array as_array(py::handle object, const std::string& name) {
         // plain array costs one compare.
         if (Py_TYPE(object.ptr()) != py::detail::npy_api::get().PyArray_Type_) {
             const py::object ma = numpy().attr("ma");
-            if (py::isinstance(object, ma.attr("MaskedArray")) && ma.attr("is_masked")(object).cast<bool>())
+            if (py::isinstance(object, ma.attr("MaskedArray")) &&
+                call_python(ma.attr("is_masked"), py::make_tuple(object)).cast<bool>())
                 throw py::value_error(name + " is a masked array with masked entries, whose values would be used; " +
                                       "pass " + name + ".filled(...) or only the rows to use");
         }
         return py::reinterpret_borrow<py::array>(object);
     }
     try {
-        return numpy().attr("asarray")(object);
+        return call_python(numpy().attr("asarray"), py::make_tuple(object));
     } catch (py::error_already_set& e) {
         if (passes_through(e)) throw;
         throw py::value_error(name + " is not an array: " + message_of(e));
@@ -46,10 +49,15 @@ void check_real(const py::array& a, const std::string& name) {
         throw py::value_error(name + " must hold real numbers, got dtype " + dtype_of(a));
 }
 
-// `a` as a C-contiguous, aligned array of `dtype`: `a` itself where it is one already.
+// `a` as a C-contiguous, aligned array of `dtype`: `a` itself where it is one already (float32 asked
+// of a native float32 array without a call: numpy.require is Python code, run for every call's
+// arrays and bounds).
 py::array required(const py::array& a, const char* dtype, const std::string& name) {
+    if (std::string_view(dtype) == "float32" && py::isinstance<py::array_t<float, py::array::c_style>>(a) &&
+        (a.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_) != 0)
+        return a;
     try {
-        return numpy().attr("require")(a, dtype, "CA");
+        return call_python(numpy().attr("require"), py::make_tuple(a, dtype, "CA"));
     } catch (py::error_already_set& e) {
         if (passes_through(e)) throw;
         throw py::value_error(name + " cannot be converted to " + dtype + ": " + message_of(e));
@@ -62,15 +70,18 @@ FloatRows rows_of(const py::array& a, const std::string& name, std::size_t rows)
     if (a.dtype().kind() == 'f' && a.dtype().itemsize() > 4) {
         // numpy warns of the overflow of a value past float32 (a RuntimeWarning pointing into numpy),
         // which non_finite_message names instead.
-        const py::object quiet = numpy().attr("errstate")(py::arg("over") = "ignore");
-        quiet.attr("__enter__")();
+        py::dict over;
+        over["over"] = "ignore";
+        const py::object quiet = call_python(numpy().attr("errstate"), py::tuple(), over);
+        call_python(quiet.attr("__enter__"), py::tuple());
+        const py::tuple no_exception = py::make_tuple(py::none(), py::none(), py::none());
         try {
             r.array = required(a, "float32", name);
         } catch (...) {
-            quiet.attr("__exit__")(py::none(), py::none(), py::none());
+            call_python(quiet.attr("__exit__"), no_exception);
             throw;
         }
-        quiet.attr("__exit__")(py::none(), py::none(), py::none());
+        call_python(quiet.attr("__exit__"), no_exception);
     } else {
         r.array = required(a, "float32", name);
     }

@@ -5,18 +5,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#ifdef __GLIBCXX__
-#include <cxxabi.h>
-#endif
-
-#include <chrono>
 #include <limits>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include "arrays.hpp"
 #include "batch.hpp"
+#include "interpreter_exit.hpp"
 #include "cellrt/accel.hpp"
 #include "cellrt/camera.hpp"
 #include "cellrt/device.hpp"
@@ -37,23 +32,13 @@ struct PyAccelerator {
     AccelConfig config;  // as built
 };
 
-// A thread that takes the GIL back while the interpreter finalizes is ended by pthread_exit (Python
-// before 3.14), whose unwinding ran pybind11's destructors without the GIL (Py_DECREF racing the
-// finalizing collector: a segmentation fault) or out of py::gil_scoped_release's noexcept destructor
-// (std::terminate), for a daemon thread in any call at exit (found by audit, 2026-12-07). The
-// unwinding is caught where it starts, and the thread waits there for the process to end, as Python
-// 3.14 makes such threads do itself; it holds no GIL. Nothing else changes: a thread coming back
-// before finalization takes the GIL as usual (an atexit callback that joins it still can).
+// The GIL taken back after a call that released it (interpreter_exit.hpp): a thread that took it
+// back while the interpreter finalizes ran pybind11's destructors without the GIL (a segmentation
+// fault) or unwound out of py::gil_scoped_release's noexcept destructor (std::terminate), for a
+// daemon thread in any call at exit (found by audit, 2026-12-07). An atexit callback that joins a
+// thread coming back before finalization still can.
 void take_gil_back(PyThreadState* state) {
-#ifdef __GLIBCXX__
-    try {
-        PyEval_RestoreThread(state);
-    } catch (abi::__forced_unwind&) {
-        for (;;) std::this_thread::sleep_for(std::chrono::hours(24));
-    }
-#else
-    PyEval_RestoreThread(state);
-#endif
+    unless_the_interpreter_ends([&] { PyEval_RestoreThread(state); });
 }
 
 // Runs `f` with the GIL released, taken back by take_gil_back (never in a destructor). Every caller
@@ -307,7 +292,7 @@ py::array render_scene(py::handle scene_object, py::handle kind, py::handle size
 std::shared_ptr<Scene> load(py::handle path) {
     py::object p;
     try {
-        p = py::module_::import("os").attr("fspath")(path);
+        p = call_python(py::module_::import("os").attr("fspath"), py::make_tuple(path));
     } catch (py::error_already_set& e) {
         if (passes_through(e)) throw;
         throw py::value_error("path must be a str or os.PathLike, got " + py::repr(path).cast<std::string>());

@@ -243,22 +243,28 @@ def test_the_interpreter_ends_while_a_daemon_thread_renders():
     assert done.returncode == 0, done.stderr
 
 
-@pytest.mark.parametrize("call", ["acc.intersect(o, d)", "acc.occluded(o, d)", "cellrt.Accelerator(tri)",
-                                  "cellrt.load_scene('builtin:spheres?tris=100')"])
-def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call):
+@pytest.mark.parametrize("call, threads", [("acc.intersect(o, d)", 3), ("acc.occluded(o, d)", 3),
+                                           ("cellrt.Accelerator(tri)", 3),
+                                           ("cellrt.load_scene('builtin:spheres?tris=100')", 3),
+                                           ("acc.occluded(o64, d64)", 8), ("cellrt.Accelerator(tri64)", 8)])
+def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call, threads):
     # Short calls in a loop: the thread took the GIL back as the interpreter finalized, which ended it
     # by pthread_exit; unwinding out of py::gil_scoped_release's destructor was std::terminate
     # (status 134; found by audit, 2026-12-07), and unwinding pybind11's frames without the GIL a
     # segmentation fault in one run of three. Three threads, under which a first fix (an atexit
-    # barrier) hung.
+    # barrier) hung. The same where Python code runs inside a call (numpy.require and errstate,
+    # converting float64 rays, triangles and the bounds): 35 exits of 40 crashed with eight threads
+    # over float64 rays, one of a hundred with three over float32 rays under load (found on CI's
+    # load, 2026-12-07; python/interpreter_exit.hpp).
     code = ("import threading, time, numpy as np, cellrt\n"
-            "tri = np.eye(3, dtype=np.float32)[None]\n"
+            "tri = np.eye(3, dtype=np.float32)[None]; tri64 = tri.astype(np.float64)\n"
             "acc = cellrt.Accelerator(tri)\n"
             "o = np.zeros((8, 3), np.float32); d = np.ones((8, 3), np.float32)\n"
+            "o64 = o.astype(np.float64); d64 = d.astype(np.float64)\n"
             "def loop():\n"
             "    while True:\n"
             f"        {call}\n"
-            "for _ in range(3):\n"
+            f"for _ in range({threads}):\n"
             "    threading.Thread(target=loop, daemon=True).start()\n"
             "time.sleep(0.2)\n")
     for _ in range(5):
