@@ -9,11 +9,12 @@
 // it, and a cell is skipped after a hit only when it starts more than m beyond the best t. m bounds
 // the rounding error of both a plane distance and the watertight test's t for points inside the scene
 // box: it is a fixed fraction of the largest distance from the origin to the box, in units of t.
-// A plane of axis a is widened by more, m·|d|/|d_a| up to a factor √3 (axis_margins): the same
-// fraction in space, across the plane. An ill-conditioned hit's t (triangle.hpp, refined_t) is the depth of a point
-// within rounding of the ray in space, which on a ray nearly parallel to the plane can lie far in t
-// from where the ray crosses it: a triangle in an axis plane, in a box or cell of no thickness there,
-// was culled by a margin in t alone (found by audit, 2026-12-07: Structures/GrazingAxisPlanes).
+// A plane of axis a is widened by at least m/16 · |d|/|d_a| as well (axis_margins): 2^-20 of the
+// reach in space, across the plane. An ill-conditioned hit's t (triangle.hpp, refined_t) is the
+// depth of a point within rounding of the ray in space, which on a ray nearly parallel to the plane
+// can lie far in t from where the ray crosses it: a triangle in an axis plane, in a box or cell of no
+// thickness there, was culled by a margin in t alone (found by audit, 2026-12-07:
+// Structures/GrazingAxisPlanes).
 #pragma once
 
 #include <cmath>
@@ -77,21 +78,24 @@ CELLRT_HD inline bool direct_margin_holds(float m) { return m > 0.f && m < kInfi
     return traversal_margin_rescaled(reach, dir);
 }
 
-// The margins of the three axes' planes, in t, from the margin in t and the reciprocal direction:
-// spread · |1/d_a|, where the spread, the margin times √3 times the largest |d| (1 over the least
-// |1/d|), is at least the margin times |d| (to rounding, which the margin's slack of 2^8 covers), the
-// margin as a length along the ray; so a plane is widened in space by that length across it, and in
-// t by at least the margin. At most FLT_MAX (a zero component's, whose plane distances are infinite
-// or NaN, which no finite margin moves). The SIMD set-up (simd/ray_lanes.inl) takes the same
-// operations in the same order.
-inline constexpr float kSqrt3 = 0x1.bb67b0p+0f;  // √3 rounded up
+// The margins of the three axes' planes, in t, from the margin in t, the direction's largest
+// component |d|max and the reciprocal direction: the larger of the margin and the margin times
+// (√3/16 · |d|max · |1/d_a|), which is at least a sixteenth of the margin times |d|, the margin as a
+// length along the ray, over |d_a|: a plane is widened in space across it by 2^-20 of the
+// scene's reach, sixteen times the rounding of a point within rounding of the ray (and of a
+// refined hit's, some 2^-30 of it where measured). A sixteenth: the whole margin across the planes
+// cost camera rays 1.4 % more leaves and 2.4 % more triangles (the bunny's kd-tree), rays nearly
+// parallel to the planes running along them within the margin for long. At most FLT_MAX (a zero
+// component's, whose plane distances are infinite or NaN, which no finite margin moves). The SIMD
+// set-up (simd/ray_lanes.inl) takes the same operations in the same order.
+inline constexpr float kAcrossScale = 0x1.bb67b0p-4f;  // √3/16 rounded up
 template <class Inverse>
-CELLRT_HD inline Vec3 axis_margins(float margin, const Inverse& inv) {
-    const float least = std::fmin(std::fabs(inv[0]), std::fmin(std::fabs(inv[1]), std::fabs(inv[2])));
-    const float spread = margin * kSqrt3 / least;
+[[gnu::always_inline]] CELLRT_HD inline Vec3 axis_margins(float margin, float dir_max, const Inverse& inv) {
+    // The factors first, apart from the margin, which comes last on the set-up's longest chain.
+    const float spread = kAcrossScale * dir_max;
     Vec3 m;
     for (int a = 0; a < 3; ++a) {
-        const float x = spread * std::fabs(inv[a]);
+        const float x = margin * (spread * std::fabs(inv[a]));
         m[a] = x < kLargestFloat ? (x > margin ? x : margin) : kLargestFloat;
     }
     return m;
@@ -113,7 +117,8 @@ struct TraversalRay {
             dir_neg[a] = std::signbit(dir[a]) ? 1u : 0u;
         }
         margin = traversal_margin(max(abs(scene_box.lo - org), abs(scene_box.hi - org)), dir);
-        axis_margin = axis_margins(margin, inv_dir);
+        const Vec3 d = abs(dir);  // finite (a valid ray's): max, not fmax, which is a call
+        axis_margin = axis_margins(margin, std::max(d.x, std::max(d.y, d.z)), inv_dir);
     }
 
     CELLRT_HD Vec3 at(float t) const { return org + dir * t; }

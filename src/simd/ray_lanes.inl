@@ -163,10 +163,10 @@ inline RayLanes load_ray_lanes(const Ray* rays, std::size_t n, const Box3& scene
                 L.margin[i] = traversal_margin_rescaled({reach[0][i], reach[1][i], reach[2][i]},
                                                         {L.dir[0][i], L.dir[1][i], L.dir[2][i]});
     // axis_margins, lane by lane in its operations and order.
-    const F least_inv = min_lanes(abs_lanes(L.inv[0]), min_lanes(abs_lanes(L.inv[1]), abs_lanes(L.inv[2])));
-    const F spread = L.margin * splat(kSqrt3) / least_inv;
+    const F dir_max = max_lanes(abs_lanes(L.dir[0]), max_lanes(abs_lanes(L.dir[1]), abs_lanes(L.dir[2])));
+    const F spread = splat(kAcrossScale) * dir_max;
     for (int a = 0; a < 3; ++a) {
-        const F x = spread * abs_lanes(L.inv[a]);
+        const F x = L.margin * (spread * abs_lanes(L.inv[a]));
         L.axis_margin[a] = select(x < splat(kLargestFloat), select(x > L.margin, x, L.margin), splat(kLargestFloat));
     }
     return L;
