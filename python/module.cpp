@@ -477,7 +477,10 @@ PYBIND11_MODULE(cellrt, m) {
                  // Not refused: the caller may give the scene a camera and light of its own.
                  if (const std::string why = default_view_problem(*s); !why.empty()) {
                      const std::string warning = "triangles: " + why + "; set scene.camera and scene.light";
-                     if (PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+                     // Showing a warning runs Python code (warnings._showwarnmsg): interpreter_exit.hpp.
+                     const char* const text = warning.c_str();
+                     if (unless_the_interpreter_ends([&] { return PyErr_WarnEx(PyExc_RuntimeWarning, text, 1); }) != 0)
+                         throw py::error_already_set();
                  }
                  return s;
              }),
