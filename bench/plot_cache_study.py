@@ -3,13 +3,16 @@
 per graph and scene:
 
   5-1 / 5-3   node-cache hit ratio vs line size, kd / BIH (triangle cache 128 x 128)
-  5-2 / 5-4   modelled frame time vs node-cache layout, kd / BIH (measured, from cache-study --device cuda)
+  5-2 / 5-4   modelled frame time vs node-cache layout, kd / BIH (the kernels' measured time where
+              every row's cycles are 0: a CSV of cache-study --device cuda)
   5-5 / 5-6   asynchronous vs synchronous access: time ratio per node-cache layout, kd / BIH
   5-7 / 5-9   triangle-cache hit ratio vs line size, kd / BIH (node cache at the study's best)
   5-8 / 5-10  modelled frame time vs triangle-cache layout, kd / BIH (likewise)
 
 One line per number of sets: solid direct-mapped, dashed 4-way. Hit ratios are drawn for the
-branchless traversal (the branched one reads the same lines; docs/LOCALSTORE.md).
+branchless traversal where the CSV has it, and its title says which: the kd-tree's branched
+traversal reads the same lines, the BIH's does not (its branchless traversal visits more nodes;
+docs/LOCALSTORE.md), so a BIH graph stands for its branchless runs only.
 
 usage: bench/plot_cache_study.py [--overwrite] cache_study.csv OUTDIR
 
@@ -119,7 +122,7 @@ def main() -> int:
         for ax, access in zip(axes[0], accesses):
             sel = [r for r in rs if r["access"] == access and r["traversal"] == hit_traversal]
             draw(ax, curves(sel, sweep, lambda r: hit_ratio(r, cache)), "hit ratio (%)",
-                 f"{scene}, {structure}: {name}, {access}")
+                 f"{scene}, {structure} {hit_traversal}: {name}, {access}")
         axes[0][-1].legend(fontsize=7)
         save(fig, outdir, hit_graph, scene, f"{structure}_{sweep}_hit_ratio")
 
