@@ -5,7 +5,7 @@
 // std::terminate out of a noexcept destructor. A thread takes the GIL back where the module released
 // it (PyEval_RestoreThread), and wherever Python code runs, which may hand the GIL to another thread
 // and wait for it back: numpy.require converting every ray bound crashed one exit in a hundred under
-// load (Python.test_accelerator, found on CI's load, 2026-12-07). Such calls go through here: the
+// load (Python.test_accelerator, found on a loaded machine, 2026-12-07). Such calls go through here: the
 // unwinding is caught where it leaves Python, before any C++ frame, and the thread waits there,
 // holding no GIL, for the process to end, as Python 3.14 makes such threads do itself. A thread that
 // comes back before finalization goes on as usual.

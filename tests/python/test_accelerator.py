@@ -254,8 +254,8 @@ def test_the_interpreter_ends_while_a_daemon_thread_loops_over_calls(call, threa
     # segmentation fault in one run of three. Three threads, under which a first fix (an atexit
     # barrier) hung. The same where Python code runs inside a call (numpy.require and errstate,
     # converting float64 rays, triangles and the bounds): 35 exits of 40 crashed with eight threads
-    # over float64 rays, one of a hundred with three over float32 rays under load (found on CI's
-    # load, 2026-12-07; python/interpreter_exit.hpp).
+    # over float64 rays, one of a hundred with three over float32 rays under load (found on a
+    # loaded machine, 2026-12-07; python/interpreter_exit.hpp).
     code = ("import threading, time, numpy as np, cellrt\n"
             "tri = np.eye(3, dtype=np.float32)[None]; tri64 = tri.astype(np.float64)\n"
             "acc = cellrt.Accelerator(tri)\n"
