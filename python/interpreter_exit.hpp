@@ -39,8 +39,9 @@ auto unless_the_interpreter_ends(F&& f) -> decltype(f()) {
 #endif
 }
 
-// callable(*args, **kwargs), which may run Python code: pybind11's own call, but safe at exit.
-inline py::object call_python(py::handle callable, const py::tuple& args, const py::dict& kwargs = py::dict()) {
+// callable(*args, **kwargs), which may run Python code: pybind11's own call, but safe at exit. No
+// kwargs: a null handle, as PyObject_Call takes it.
+inline py::object call_python(py::handle callable, const py::tuple& args, py::handle kwargs = py::handle()) {
     PyObject* const result =
         unless_the_interpreter_ends([&] { return PyObject_Call(callable.ptr(), args.ptr(), kwargs.ptr()); });
     if (!result) throw py::error_already_set();

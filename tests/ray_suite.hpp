@@ -240,16 +240,19 @@ inline std::vector<Ray> first_limited(const std::vector<Ray>& rays, const std::v
     return limited;
 }
 
-// The suite's rays, followed by up to `limited_count` of them limited at their reference hits.
-inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {},
-                                        std::size_t limited_count = kSuiteLimitedCount) {
-    ReferenceAnswers ref = compute_reference(tris, RaySuite(tris, options).rays());
-    std::vector<Ray> limited = first_limited(ref.rays, ref.hits, limited_count);
-    ReferenceAnswers lim = compute_reference(tris, std::move(limited));
+// `ref`'s answers followed by those of up to `limited_count` of its rays limited at their hits.
+inline ReferenceAnswers with_limited(std::span<const Triangle> tris, ReferenceAnswers ref, std::size_t limited_count) {
+    ReferenceAnswers lim = compute_reference(tris, first_limited(ref.rays, ref.hits, limited_count));
     ref.rays.insert(ref.rays.end(), lim.rays.begin(), lim.rays.end());
     ref.hits.insert(ref.hits.end(), lim.hits.begin(), lim.hits.end());
     ref.occluded.insert(ref.occluded.end(), lim.occluded.begin(), lim.occluded.end());
     return ref;
+}
+
+// The suite's rays, followed by up to `limited_count` of them limited at their reference hits.
+inline ReferenceAnswers reference_suite(std::span<const Triangle> tris, const RaySuiteOptions& options = {},
+                                        std::size_t limited_count = kSuiteLimitedCount) {
+    return with_limited(tris, compute_reference(tris, RaySuite(tris, options).rays()), limited_count);
 }
 
 // Brute force over a shared scene and the whole suite takes tens of seconds, and CTest runs every
