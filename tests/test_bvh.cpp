@@ -1006,6 +1006,10 @@ TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
         EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@" + name + "=maybe")), Error);
     }
     EXPECT_EQ(setting("auto@streams=off", "bvh_packets"), "on");
+    // Switches, as the kd-tree's and Embree's are: on/off, true/false, 1/0 (Python's False is "false").
+    EXPECT_EQ(setting("auto@streams=false,bvh_packets=0", "streams"), "off");
+    EXPECT_EQ(setting("auto@streams=false,bvh_packets=0", "bvh_packets"), "off");
+    EXPECT_EQ(setting("auto@streams=true", "streams"), "on");
     EXPECT_EQ(setting("auto@bvh_packets=off", "streams"), "on");
     // With the BVH's own packets for coherent batches, they are the first path, not a fourth.
     EXPECT_EQ(setting("auto", "packets"), "kd");

@@ -22,7 +22,7 @@ struct ParamSpec {
 
 using ParamTable = std::vector<ParamSpec>;
 
-// "[min, max]", "true, false" or "a, b, c": the values a parameter accepts, as the tables print them.
+// "[min, max]", "true, false (or on, off, 1, 0)" or "a, b, c": the values a parameter accepts, as the tables print them.
 std::string param_range(const ParamSpec& spec);
 
 // A number as the tables print it: whole numbers below 1e15 in full (2^20 as 1048576), others as %g

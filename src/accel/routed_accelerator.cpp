@@ -237,10 +237,10 @@ const ParamTable& routed_params() {
          "measured: each kind of batch (closest or any hit, coherent or not) goes to the path that took "
          "the least time per ray over runs of such batches given to each path in turn; coherence: by "
          "coherence alone, the same path (and work counts) in every run"},
-        {"streams", choice, "on", 0, 0, {"on", "off"},
+        {"streams", boolean, "on", 0, 0, {},
          "on: the measured route also times the wide BVH's stream traversal (bvh:stream) as a path and "
          "takes it for the kinds of batch it traces fastest (AO and many bounces); off: not"},
-        {"bvh_packets", choice, "on", 0, 0, {"on", "off"},
+        {"bvh_packets", boolean, "on", 0, 0, {},
          "on: the measured route also times the wide BVH's packet traversal (bvh:packet) as a path and "
          "takes it for the kinds of batch it traces fastest; off: not"},
     };
@@ -254,8 +254,8 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     const std::string packets = params.choice("packets");
     const auto threshold = static_cast<float>(params.number("coherence"));
     const bool measured = params.choice("route") == "measured";
-    const bool streams = params.choice("streams") == "on";
-    const bool bvh_packets = params.choice("bvh_packets") == "on";
+    const bool streams = params.boolean("streams");
+    const bool bvh_packets = params.boolean("bvh_packets");
     params.finish();
     // With packets=bvh the BVH's packets are the coherent batches' path: they cannot be left out.
     if (packets == "bvh" && !bvh_packets)

@@ -29,7 +29,7 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string param_range(const ParamSpec& spec) {
     switch (spec.type) {
-        case ParamType::boolean: return "true, false";
+        case ParamType::boolean: return "true, false (or on, off, 1, 0)";
         case ParamType::choice: return join(spec.choices);
         default: {
             // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on a chain of operator+.

@@ -484,6 +484,17 @@ def test_numpy_scalars_count_as_what_they_hold():
             params={"leaf_size": np.array([1])})
 
 
+def test_switches_take_python_bools():
+    # auto's streams and bvh_packets were choices of 'on' and 'off': False became 'false' and was
+    # refused, where the kd-tree's perfect_splits took it (found by audit, 2026-12-08).
+    for value, held in ((False, "off"), (True, "on"), (np.bool_(False), "off"), ("off", "off"), (0, "off")):
+        acc = cellrt.Accelerator(TRI, kind="auto", params={"streams": value, "bvh_packets": value})
+        assert acc.stats.settings["streams"] == held
+        assert acc.stats.settings["bvh_packets"] == held
+    refused(r"auto parameter streams='maybe' is not a boolean \(true/false, on/off, 1/0\)", cellrt.Accelerator,
+            TRI, kind="auto", params={"streams": "maybe"})
+
+
 @pytest.mark.parametrize("make", [lambda: cellrt.Camera(), lambda: cellrt.Light(), lambda: cellrt.Scene(TRI),
                                   lambda: cellrt.Accelerator(TRI, kind="kd"),
                                   lambda: cellrt.Accelerator(TRI, kind="kd").stats,
