@@ -2,14 +2,17 @@
 # The CUDA backend's checks on a lent GPU machine (docs/GPU.md), in two steps:
 #
 #   tools/device-check.sh prepare DIR   # here: build with CUDA and the benchmarks, pack the programs, their
-#                                       # libraries and the shared scenes into DIR (git-ignored), compressed:
-#                                       # about 26 MB (43 MB from a build with MPI) against the 64 MiB carry limit
-#   tools/device-check.sh run DIR       # there, in one go (at most CELLRT_DEVICE_SECONDS, 550 s): results under $OUT
+#                                       # libraries and the shared scenes into DIR (git-ignored), compressed by
+#                                       # xz where it is found (gzip elsewhere): about 24 MB with MPI; refused
+#                                       # when it and the working tree, which travels with it, pass 62 MiB
+#                                       # (the device tool's limit is 64 MiB for both together)
+#   tools/device-check.sh run DIR       # there, in one go (at most CELLRT_DEVICE_SECONDS, 420 s): results under $OUT
 #   tools/device-check.sh run DIR STEP...  # only these steps (gpu_tests gpu_bench cache_study scaling builds
 #                                       # mpi16 cache_study_async; build_curve, gpu_bench_packets,
 #                                       # gpu_bih_sweep and mpi16_sweep run only when named)
 #
-# `run` writes $OUT/results.tar.gz and $OUT/summary.json (each step's exit status, seconds and limit);
+# `run` writes $OUT/results.tar.gz and $OUT/summary.json (each step's exit status, seconds and limit, rewritten
+# whole after every step, with "complete": false until the last, so that a run cut short still parses);
 # the device tool returns eight files at most, so the archive holds the rest: info.log (`cellrt info
 # --device cuda`), gpu_tests.json (the GPU tests, GoogleTest's JSON), gpu_bench.json and .log (the GPU
 # benchmark beside Embree on all host cores, same rays), cache_study/ (the study's cache sweeps in the
@@ -17,8 +20,10 @@
 # docs/SCALING.md), builds_t1/t16 and builds_forest_t1/t16.json (docs/BUILD_SPEED.md), mpi/ and mpi_png/
 # (16 ranks against one process, frames as .pfm and as .png, docs/DISTRIBUTED.md) and cache_study_async/ (the node cache's sweep with
 # asynchronous access). Each step runs under a time limit of its own and the run's deadline. Without a
-# CUDA device the GPU's steps are skipped, the CPU's run, and `run` ends with status 3.
-# With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=600).
+# CUDA device the GPU's steps are skipped, the CPU's run, and `run` ends with status 3. A step whose
+# answers or frames differ from the host's exits non-zero (gpu_bench: 4; the MPI rounds: 1).
+# With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=480,
+# kind="nvidia-h200"): the H200 of the earlier figures, and time left in the session's 15 minutes to run again.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 usage() { echo "usage: tools/device-check.sh prepare DIR | run DIR [STEP...]" >&2; exit 2; }
@@ -47,15 +52,39 @@ prepare)
   for s in sponza sibenik bunny teapot; do
     if [[ -d "$scenes/$s" ]]; then cp -r "$scenes/$s" "$stage/scenes/"; else echo "note: scene $s not found under $scenes" >&2; fi
   done
-  tar -C "$stage" -czf "$dir/device-check.tar.gz" bundle scenes
-  echo "prepared $dir ($(du -sh "$dir" | cut -f1); the carry limit is 64 MiB)"
+  # xz packs the bundle to about half of gzip's size (24 against 45 MB with MPI); the device machine
+  # unpacks it with xz or, without it, Python's tarfile.
+  if command -v xz >/dev/null; then
+    XZ_OPT="-6 -T0" tar -C "$stage" -cJf "$dir/device-check.tar.xz" bundle scenes
+  else
+    tar -C "$stage" -czf "$dir/device-check.tar.gz" bundle scenes
+  fi
+  # What travels to the device machine: the files git tracks, those it neither tracks nor ignores, and
+  # the carried folder, 64 MiB together (a larger call is refused, costing device time).
+  tree_bytes=$(cd "$root" && { git ls-files -z --cached --others --exclude-standard; } | xargs -0 -r stat -c %s -- 2>/dev/null |
+    awk '{ s += $1 } END { print s + 0 }')
+  packed_bytes=$(du -sb "$dir" | cut -f1)
+  total_mib=$(( (tree_bytes + packed_bytes) / 1048576 ))
+  echo "prepared $dir: $((packed_bytes / 1048576)) MiB, with the working tree $total_mib MiB of the 64 MiB that may travel"
+  if (( tree_bytes + packed_bytes > 62 * 1048576 )); then
+    echo "tools/device-check.sh: $dir and the working tree come to $total_mib MiB, over the 62 MiB this script allows" \
+         "(64 MiB travel at most); build without MPI (-DCELLRT_MPI=OFF) or pack fewer scenes" >&2
+    exit 1
+  fi
   ;;
 run)
   out="${OUT:?run writes its results under \$OUT}"
-  packed="$(cd "$dir" && pwd)/device-check.tar.gz"
+  packed="$(cd "$dir" && pwd)/device-check.tar.xz"
+  [[ -f "$packed" ]] || packed="${packed%.xz}.gz"
   dir="$(mktemp -d)"
   trap 'rm -rf "$dir"' EXIT
-  tar -C "$dir" -xzf "$packed"
+  if [[ "$packed" == *.gz ]] || command -v xz >/dev/null; then
+    tar -C "$dir" -xaf "$packed"
+  else
+    python3 -c 'import sys, tarfile
+kept = {"filter": "tar"} if hasattr(tarfile, "tar_filter") else {}  # links and modes as packed
+tarfile.open(sys.argv[1]).extractall(sys.argv[2], **kept)' "$packed" "$dir"
+  fi
   run="$dir/bundle/run"
   res="$dir/results"
   mkdir -p "$res/mpi" "$res/mpi_sweep" "$dir/frames"
@@ -68,23 +97,27 @@ run)
   # The device tool returns at most eight files: every result goes into one archive, packed again
   # after each step (and renamed into place), so that a call cut short still returns what was done.
   # Each step stops at its own limit or at the run's deadline, whichever comes first.
-  deadline=$((SECONDS + ${CELLRT_DEVICE_SECONDS:-550}))
-  summary="$res/summary.json"
-  echo "{" > "$summary"
+  deadline=$((SECONDS + ${CELLRT_DEVICE_SECONDS:-420}))
+  summary="$res/summary.json" entries="$dir/summary.entries" gpu=null
+  : > "$entries"
+  note() {  # NAME JSON: one step's entry; the summary is written whole again, valid JSON at every step
+    echo "  \"$1\": $2" >> "$entries"
+    { echo "{"; sed 's/$/,/' "$entries"; echo "  \"device\": $gpu, \"complete\": ${3:-false}"; echo "}"; } > "$summary"
+    cp "$summary" "$out/summary.json"
+  }
   timed() {  # NAME LIMIT_S COMMAND...: runs it under its limit, logs to NAME.log, notes status and time
     local name="$1" limit="$2"; shift 2
     local left=$((deadline - SECONDS)) start=$SECONDS status=0
     if ((left < limit)); then limit=$left; fi
     if ((limit < 5)); then
-      echo "  \"$name\": {\"status\": \"skipped: the run's deadline\"}," >> "$summary"
+      note "$name" "{\"status\": \"skipped: the run's deadline\"}"
       echo "$name: skipped (the run's deadline)"
       return
     fi
     timeout "$limit" "$@" > "$res/$name.log" 2>&1 || status=$?
-    echo "  \"$name\": {\"status\": $status, \"seconds\": $((SECONDS - start)), \"limit\": $limit}," >> "$summary"
+    note "$name" "{\"status\": $status, \"seconds\": $((SECONDS - start)), \"limit\": $limit}"
     echo "$name: status $status, $((SECONDS - start)) s (limit $limit s)"
     tar -C "$dir" -czf "$out/.results.tar.gz" results && mv "$out/.results.tar.gz" "$out/results.tar.gz"
-    cp "$summary" "$out/summary.json"
   }
   timed info 20 "$run" cellrt info --device cuda
   # Without a GPU (a driver that fails, a machine lent without one) the CPU's steps still run: the
@@ -99,11 +132,11 @@ run)
   wanted() { [[ -z "$steps" ]] || named "$1"; }  # steps of the default run
   on_gpu() {  # NAME: a GPU step, skipped (and noted) without a device
     $gpu && return 0
-    echo "  \"$1\": {\"status\": \"skipped: no CUDA device\"}," >> "$summary"
+    note "$1" "{\"status\": \"skipped: no CUDA device\"}"
     return 1
   }
   wanted gpu_tests && on_gpu gpu_tests && timed gpu_tests 120 "$run" cellrt_tests --gtest_filter='*Cuda*' --gtest_output="json:$res/gpu_tests.json"
-  wanted gpu_bench && on_gpu gpu_bench && timed gpu_bench 170 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
+  wanted gpu_bench && on_gpu gpu_bench && timed gpu_bench 200 "$run" cellrt_gpu_bench --scenes-dir "$CELLRT_SCENES" \
     --scenes sponza sibenik bunny builtin:city --size 1920x1080 --rays frame ao diffuse --repeats 3 --json "$res/gpu_bench.json"
   wanted cache_study && on_gpu cache_study && timed cache_study 50 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" --device cuda \
     --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access sync -o "$res/cache_study"
@@ -154,8 +187,8 @@ run)
   # last pixel, the same span in both programs), without start-up, loading and building. Frames
   # are written as .pfm (float pixels), or as .png with FRAME_EXT=png (cellrt-mpi's ranks then send
   # 8-bit pixels). mpi_rounds INTO NAME=PROGRAM ARGS...
-  mpi_rounds() {
-    local into="$1" first="${2%%=*}" ext="${FRAME_EXT:-pfm}" spec name args r
+  mpi_rounds() {  # status 1 when a run failed or a frame differed, after every round was run
+    local into="$1" first="${2%%=*}" ext="${FRAME_EXT:-pfm}" spec name args r failed=0
     shift
     mkdir -p "$into"
     for r in 1 2 3 4 5; do
@@ -163,10 +196,11 @@ run)
         name="${spec%%=*}"
         read -ra args <<<"${spec#*=}"
         "$run" "${args[@]}" --size 1920x1080 -o "$frames/$name.$ext" --stats "$into/$name.$r.json" --overwrite \
-          > /dev/null || echo "$name: status $?"
-        cmp "$frames/$name.$ext" "$frames/$first.$ext" || echo "$name: the frame differs"
+          > /dev/null || { echo "$name: status $?"; failed=1; }
+        cmp "$frames/$name.$ext" "$frames/$first.$ext" || { echo "$name: the frame differs"; failed=1; }
       done
     done
+    return "$failed"
   }
   frames="$dir/frames" sponza="$CELLRT_SCENES/sponza/sponza.json"
   export -f mpi_rounds
@@ -206,8 +240,7 @@ run)
   wanted cache_study_async && on_gpu cache_study_async && timed cache_study_async 30 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" \
     --device cuda --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access async --sweeps node \
     -o "$res/cache_study_async"
-  echo "  \"device\": $gpu }" >> "$summary"
-  cp "$summary" "$out/summary.json"
+  note run "{\"seconds\": $SECONDS}" true
   $gpu || exit 3
   ;;
 *) usage ;;

@@ -21,6 +21,7 @@ DeviceInfo cuda_device_info() {
     cudaDeviceProp p{};
     if (const cudaError_t e = cudaGetDeviceProperties(&p, 0); e != cudaSuccess) {
         info.reason = cudaGetErrorString(e);
+        cudaGetLastError();  // as above: a later launch's check would report this error as its own
         return info;
     }
     info.present = true;

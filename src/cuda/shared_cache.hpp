@@ -129,7 +129,9 @@ inline std::uint32_t tick(std::uint32_t* clock) { return ++*clock; }
 // did not wait would read the slot's old bytes (and fail the tests). A filling slot's sequence number
 // stays odd until the wait, so other threads never read it half-filled.
 struct AsyncFills {
-    static constexpr int kMax = 4;  // a child pair spans at most two lines
+    // A child pair spans at most three lines (two 12-byte BIH nodes over 16-byte lines); a full list
+    // is waited for before it grows.
+    static constexpr int kMax = 4;
     std::uint32_t slot[kMax];
     std::uint32_t seq[kMax];   // the slot's even sequence number before the fill claimed it
     std::uint64_t line[kMax];  // the line's address, for the host's copy
