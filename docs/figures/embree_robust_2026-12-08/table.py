@@ -22,7 +22,7 @@ cellrt = ["bvh:paired", "bvh:packet", "auto"]
 print("| rays | scene | Embree's best, robust=false ÷ robust | rtcIntersect1/rtcOccluded1, robust=false ÷ robust | "
       "cellrt's best ÷ Embree's best, robust (the yardstick) | the same ÷ Embree's best, robust=false | which cellrt path |")
 print("|---|---|--:|--:|--:|--:|---|")
-for rays in ("frame", "ao", "random"):
+for rays in ("frame", "ao", "diffuse", "random"):
     for scene in ("sponza", "sibenik", "bunny", "teapot"):
         if (rays, scene, "auto") not in rate:
             continue
