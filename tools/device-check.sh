@@ -21,9 +21,11 @@
 # (16 ranks against one process, frames as .pfm and as .png, docs/DISTRIBUTED.md) and cache_study_async/ (the node cache's sweep with
 # asynchronous access). Each step runs under a time limit of its own and the run's deadline. Without a
 # CUDA device the GPU's steps are skipped, the CPU's run, and `run` ends with status 3. A step whose
-# answers or frames differ from the host's exits non-zero (gpu_bench: 4; the MPI rounds: 1).
+# answers or frames differ from the host's exits non-zero (gpu_bench: 4; the MPI rounds: 1, also where
+# a run failed), and `run` then ends with status 1, naming the failed steps in summary.json.
 # With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=480,
-# kind="nvidia-h200"): the H200 of the earlier figures, and time left in the session's 15 minutes to run again.
+# kind="nvidia-h200"): the H200 of the earlier figures, and time left in the session's 15 minutes for a
+# shorter second call naming a few steps.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 usage() { echo "usage: tools/device-check.sh prepare DIR | run DIR [STEP...]" >&2; exit 2; }
@@ -61,8 +63,9 @@ prepare)
   fi
   # What travels to the device machine: the files git tracks, those it neither tracks nor ignores, and
   # the carried folder, 64 MiB together (a larger call is refused, costing device time).
-  tree_bytes=$(cd "$root" && { git ls-files -z --cached --others --exclude-standard; } | xargs -0 -r stat -c %s -- 2>/dev/null |
-    awk '{ s += $1 } END { print s + 0 }')
+  # (A tracked file deleted from the working tree has no size: stat's failure is not the script's.)
+  tree_bytes=$(cd "$root" && { git ls-files -z --cached --others --exclude-standard; } |
+    { xargs -0 -r stat -c %s -- 2>/dev/null || true; } | awk '{ s += $1 } END { print s + 0 }')
   packed_bytes=$(du -sb "$dir" | cut -f1)
   total_mib=$(( (tree_bytes + packed_bytes) / 1048576 ))
   echo "prepared $dir: $((packed_bytes / 1048576)) MiB, with the working tree $total_mib MiB of the 64 MiB that may travel"
@@ -98,9 +101,12 @@ tarfile.open(sys.argv[1]).extractall(sys.argv[2], **kept)' "$packed" "$dir"
   # after each step (and renamed into place), so that a call cut short still returns what was done.
   # Each step stops at its own limit or at the run's deadline, whichever comes first.
   deadline=$((SECONDS + ${CELLRT_DEVICE_SECONDS:-420}))
-  summary="$res/summary.json" entries="$dir/summary.entries" gpu=null
+  summary="$res/summary.json" entries="$dir/summary.entries" gpu=null failed=()
   : > "$entries"
-  note() {  # NAME JSON: one step's entry; the summary is written whole again, valid JSON at every step
+  pack() {  # the results so far into $OUT, renamed into place
+    tar -C "$dir" -czf "$out/.results.tar.gz" results && mv "$out/.results.tar.gz" "$out/results.tar.gz"
+  }
+  note() {  # NAME JSON [COMPLETE]: one step's entry; the summary is written whole again, valid JSON at every step
     echo "  \"$1\": $2" >> "$entries"
     { echo "{"; sed 's/$/,/' "$entries"; echo "  \"device\": $gpu, \"complete\": ${3:-false}"; echo "}"; } > "$summary"
     cp "$summary" "$out/summary.json"
@@ -117,7 +123,9 @@ tarfile.open(sys.argv[1]).extractall(sys.argv[2], **kept)' "$packed" "$dir"
     timeout "$limit" "$@" > "$res/$name.log" 2>&1 || status=$?
     note "$name" "{\"status\": $status, \"seconds\": $((SECONDS - start)), \"limit\": $limit}"
     echo "$name: status $status, $((SECONDS - start)) s (limit $limit s)"
-    tar -C "$dir" -czf "$out/.results.tar.gz" results && mv "$out/.results.tar.gz" "$out/results.tar.gz"
+    # info's status says whether there is a device (3: none), not whether it failed.
+    if ((status != 0)) && [[ "$name" != info ]]; then failed+=("\"$name\""); fi
+    pack
   }
   timed info 20 "$run" cellrt info --device cuda
   # Without a GPU (a driver that fails, a machine lent without one) the CPU's steps still run: the
@@ -240,7 +248,9 @@ tarfile.open(sys.argv[1]).extractall(sys.argv[2], **kept)' "$packed" "$dir"
   wanted cache_study_async && on_gpu cache_study_async && timed cache_study_async 30 "$run" cellrt cache-study "$CELLRT_SCENES/sponza/sponza.json" \
     --device cuda --size 1920x1080 --sample 4 --structures kd bih --traversals branched --access async --sweeps node \
     -o "$res/cache_study_async"
-  note run "{\"seconds\": $SECONDS}" true
+  note run "{\"seconds\": $SECONDS, \"failed\": [$(IFS=,; echo "${failed[*]}")]}" true
+  pack
+  if ((${#failed[@]} > 0)); then echo "failed: ${failed[*]}"; exit 1; fi
   $gpu || exit 3
   ;;
 *) usage ;;

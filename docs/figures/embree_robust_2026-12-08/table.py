@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Embree robust (cellrt's yardstick) against Embree's own default (robust=false), and cellrt's paths
 against both: total rays per second (primary + second kind) of each configuration in each run,
-medians over the runs. Usage: table.py RUN.json...  (prints Markdown)."""
+medians over the runs. Usage: table.py frame_?.json ao_?.json diffuse_?.json random_?.json (prints
+Markdown; not kdsingle_?.json, whose frame runs hold other configurations beside Embree's)."""
 import json
 import statistics
 import sys
