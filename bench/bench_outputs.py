@@ -16,6 +16,25 @@ def check_output(parser, option, path, overwrite):
         parser.error(f"{option} {path}: file exists (pass --overwrite to replace it)")
 
 
+class InputError(Exception):
+    """A bad input file, in words that name it: printed by run() as it is."""
+
+
+def load_json(path, rows=False):
+    """The JSON in `path`; with rows=True, a non-empty list (a benchmark's rows). Raises InputError
+    naming the file where it is not JSON or holds no rows (json's own message names no file; an
+    empty list printed a table's header or nothing, with status 0: found by audit, 2026-12-08)."""
+    import json
+    with open(path, encoding="utf-8") as f:
+        try:
+            data = json.load(f)
+        except json.JSONDecodeError as e:
+            raise InputError(f"{path}: not JSON: {e}") from None
+    if rows and (not isinstance(data, list) or not data):
+        raise InputError(f"{path}: holds no rows (a benchmark's JSON is a non-empty list)")
+    return data
+
+
 def run(main, name):
     """Runs a script's main() and turns what a bad input raises (a file that is not there or not
     readable, JSON that is not JSON, a file of another program or shape, a value that does not parse)
@@ -26,6 +45,8 @@ def run(main, name):
     import sys
     try:
         return main()
+    except InputError as e:
+        sys.exit(f"{name}: error: {e}")
     except KeyError as e:
         sys.exit(f"{name}: error: an input has no field {e} (is it the file this script reads?)")
     except json.JSONDecodeError as e:

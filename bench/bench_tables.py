@@ -5,7 +5,6 @@ Embree's fastest configuration in the same run.
 
 usage: bench/bench_tables.py bench.json [CONFIG ...]   (only the named configurations, if given)
 """
-import json
 import sys
 import bench_outputs
 
@@ -18,8 +17,7 @@ def main() -> int:
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    with open(sys.argv[1], encoding="utf-8") as f:
-        rows = json.load(f)
+    rows = bench_outputs.load_json(sys.argv[1], rows=True)
     only = set(sys.argv[2:])
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     for scene in scenes:

@@ -5,7 +5,6 @@ and the traversal speeds (primary + second kind of rays), from their --json file
 
 usage: bench/build_speed_table.py BEFORE.json AFTER.json   (several runs: BEFORE1.json,BEFORE2.json ...)
 """
-import json
 import statistics
 import sys
 import bench_outputs
@@ -14,8 +13,7 @@ import bench_outputs
 def load(arg):
     rows = []
     for path in arg.split(","):
-        with open(path, encoding="utf-8") as f:
-            rows += json.load(f)
+        rows += bench_outputs.load_json(path, rows=True)
     return rows
 
 

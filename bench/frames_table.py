@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """frames_ab.sh's runs: per shading, scene, workers and config, the median frame seconds of the old
 binary (a) and the new (b), new ÷ old, and each side's median ratio to Embree's packet8 in its runs."""
-import json
 import re
 import statistics
 import sys
@@ -18,7 +17,7 @@ def main():
     cells = {}
     for path in sys.argv[1:]:
         who = re.search(r'frames_([ab])_', path).group(1)
-        runs = json.load(open(path))
+        runs = bench_outputs.load_json(path, rows=True)
         emb = {(r['shading'], r['scene'], r['workers']): r['seconds'] for r in runs if r['config'] == 'embree:packet8'}
         for r in runs:
             key = (r['shading'], r['scene'], r['workers'], r['config'])

@@ -5,7 +5,7 @@ run, as speed ratios (Embree's time / config's time); the median of the runs, an
 A config a run did not measure is left out of that run's figures ("–" where no run has it); the
 last column, kd:rec's primary rays over rtcIntersect1's, is left out, with a note, where the runs
 lack kd:rec or embree:single (CONFIGS of incoherent_state.sh)."""
-import json, glob, statistics, sys
+import glob, statistics, sys
 import bench_outputs
 
 
@@ -15,7 +15,7 @@ def main():
     if not any(files.values()):
         sys.exit('incoherent_state_table.py: error: no state_KIND_RUN.json files here (run it in the folder '
                  'incoherent_state.sh wrote)')
-    runs = {kind: [json.load(open(f)) for f in fs] for kind, fs in files.items()}
+    runs = {kind: [bench_outputs.load_json(f, rows=True) for f in fs] for kind, fs in files.items()}
     rows = [r for rs in runs.values() for run in rs for r in run]
     if not any(r['config'].startswith('embree') for r in rows):
         sys.exit('incoherent_state_table.py: error: the runs have no Embree configuration, and every figure '

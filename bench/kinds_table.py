@@ -11,7 +11,6 @@ usage: bench/kinds_table.py PREFIX KIND... [--second] [--configs CONFIG...]
 its figure for both kinds. A configuration that reports its route (`auto`: the share of rays each
 path answered) gets a second table of those shares.
 """
-import json
 import sys
 import bench_outputs
 
@@ -46,8 +45,7 @@ def main(argv) -> int:
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * 2 + "--:|" * (len(head) - 2))
     for kind in kinds:
-        with open(f"{prefix}_{kind}.json", encoding="utf-8") as f:
-            rows = json.load(f)
+        rows = bench_outputs.load_json(f"{prefix}_{kind}.json", rows=True)
         for scene in dict.fromkeys(r["scene"] for r in rows):
             rs = {r["config"]: r for r in rows if r["scene"] == scene}
             embree = [c for c in rs if c.startswith("embree")]
@@ -70,8 +68,8 @@ def main(argv) -> int:
             print("| " + " | ".join(cells) + " |")
     routed = []
     for kind in kinds:
-        with open(f"{prefix}_{kind}.json", encoding="utf-8") as f:
-            routed += [(kind, r["scene"], r["config"], r["routed"]) for r in json.load(f) if r.get("routed")]
+        rows = bench_outputs.load_json(f"{prefix}_{kind}.json", rows=True)
+        routed += [(kind, r["scene"], r["config"], r["routed"]) for r in rows if r.get("routed")]
     if routed:
         print("\n| rays | scene | config | share of rays per path (primary: closest; second kind: closest or any) |")
         print("|---|---|---|---|")

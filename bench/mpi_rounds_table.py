@@ -13,7 +13,6 @@ the frame), the plain program's frame on as many threads over it, and the ranks'
 """
 import argparse
 import glob
-import json
 import os
 import statistics
 import bench_outputs
@@ -25,9 +24,9 @@ def load(path):
     if os.path.isdir(path):
         for f in sorted(glob.glob(os.path.join(path, "*.json"))):
             name = os.path.basename(f)[: -len(".json")]
-            runs[name] = json.load(open(f))
+            runs[name] = bench_outputs.load_json(f)
     else:
-        runs = json.load(open(path))
+        runs = bench_outputs.load_json(path)
     by_config = {}
     for key, stats in runs.items():
         config, _, round_ = key.rpartition(".")

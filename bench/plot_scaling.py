@@ -13,7 +13,6 @@ the frame's rays, which the frame size sets): otherwise the script names the two
 curve would join points of different work. The efficiency is the JSON's own (the median of each
 round's ratio to the fewest workers) where it has one, else t(first) first / (t(N) N) from the medians.
 """
-import json
 import os
 import sys
 from collections import defaultdict
@@ -41,8 +40,7 @@ def main() -> int:
     data = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))
     try:
         for path in inputs:
-            with open(path, encoding="utf-8") as f:
-                points = json.load(f)
+            points = bench_outputs.load_json(path, rows=True)
             for p in points:
                 frame = (p.get("shading", "direct"), p.get("ao_samples"), p["rays"])
                 first, other = frames.setdefault(p["scene"], (frame, path))
@@ -62,7 +60,7 @@ def main() -> int:
             out = os.path.join(outdir, f"scaling_{scene}.png")
             if os.path.exists(out) and not overwrite:
                 raise ValueError(f"{out}: file exists (pass --overwrite to replace it)")
-    except (OSError, ValueError, KeyError, TypeError) as e:
+    except (OSError, ValueError, KeyError, TypeError, bench_outputs.InputError) as e:
         print(f"plot_scaling.py: error: {e if not isinstance(e, KeyError) else f'a point has no {e}'}",
               file=sys.stderr)
         return 1

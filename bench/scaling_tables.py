@@ -6,7 +6,6 @@ dispatch and packet size).
 
 usage: bench/scaling_tables.py scaling.json [CONFIG ...]   (only the named configurations, if given)
 """
-import json
 import sys
 import bench_outputs
 
@@ -15,8 +14,7 @@ def main() -> int:
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    with open(sys.argv[1], encoding="utf-8") as f:
-        points = json.load(f)
+    points = bench_outputs.load_json(sys.argv[1], rows=True)
     only = sys.argv[2:]
     configs = only or list(dict.fromkeys(p["config"] for p in points))
     workers = sorted({p["workers"] for p in points})

@@ -517,7 +517,7 @@ def fmt(x, digits=0):
 
 def tables(path, split_scenes=("sponza",)):
     """The markdown tables of docs/INCOHERENT.md from a JSON this script wrote."""
-    doc = json.load(open(path))
+    doc = bench_outputs.load_json(path)
     rows = doc["rows"]
     configs = list(dict.fromkeys(r["config"] for r in rows))
     scenes = list(dict.fromkeys(r["scene"] for r in rows))

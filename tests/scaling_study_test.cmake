@@ -118,3 +118,16 @@ execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/plot_scaling.py ${WORK}/scalin
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/plots/scaling_city.png)
   message(FATAL_ERROR "bench/plot_scaling.py failed (${rc}), needs python3-matplotlib: ${log}")
 endif()
+# A file that is not JSON, or holds no rows, is refused naming it: json's message named no file, and
+# an empty list printed nothing with status 0 (2026-12-08).
+file(WRITE ${WORK}/cut.json "[{\"scene\":")
+file(WRITE ${WORK}/empty.json "[]")
+foreach(case "cut.json: not JSON: " "empty.json: holds no rows")
+  string(REGEX REPLACE ":.*" "" input "${case}")
+  execute_process(COMMAND ${PYTHON} ${SOURCE}/bench/scaling_tables.py ${WORK}/${input}
+                  OUTPUT_VARIABLE table ERROR_VARIABLE log RESULT_VARIABLE rc)
+  string(FIND "${log}" "scaling_tables: error: ${WORK}/${case}" at)
+  if(NOT rc EQUAL 1 OR NOT at EQUAL 0 OR NOT table STREQUAL "")
+    message(FATAL_ERROR "bench/scaling_tables.py ${input}: status ${rc}, printed '${table}${log}'")
+  endif()
+endforeach()
