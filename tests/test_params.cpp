@@ -80,6 +80,30 @@ TEST(Params, DefaultsAreValidValuesAndTheBuildsDefaults) {
     }
 }
 
+// A tree's report names every parameter in force, as the configuration takes them back: built again
+// from the report's `parameters`, the tree is the same (the kd-tree's report named its method and
+// costs only, so a report of `-P leaf_size=4` could not say which tree it described).
+TEST(Params, ReportsNameEveryParameterInForceAndBuildTheSameTreeAgain) {
+    for (const std::string spec : {"kd@leaf_size=4,empty_bonus=0.25", "kd:branched@perfect_splits=false",
+                                   "bih@split=sah,sah_max_leaf=8", "bih@leaf_size=3"}) {
+        AccelConfig c = parse_accel_config(spec);
+        c.threads = 1;
+        const AccelStats first = make_accelerator(small_scene(), c)->stats();
+        const std::string parameters = first.setting("parameters").value_or("");
+        ASSERT_FALSE(parameters.empty()) << spec;
+        for (const ParamSpec& p : accelerator_params(c.kind))
+            EXPECT_NE(parameters.find(p.name + "="), std::string::npos) << spec << ": " << parameters;
+        const std::string kind = c.kind + (c.traversal.empty() ? "" : ":" + c.traversal);
+        AccelConfig again = parse_accel_config(kind + "@" + parameters);
+        again.threads = 1;
+        const AccelStats second = make_accelerator(small_scene(), again)->stats();
+        EXPECT_EQ(second.setting("parameters"), first.setting("parameters")) << spec;
+        ASSERT_TRUE(first.tree && second.tree) << spec;
+        EXPECT_EQ(second.tree->nodes, first.tree->nodes) << spec;
+        EXPECT_EQ(second.tree->sah_cost, first.tree->sah_cost) << spec;
+    }
+}
+
 // Parameter numbers are written (the tables' defaults, the settings) and read in the C locale's form
 // whatever the process's locale: printf's "%.0f" and "%g" as the C locale writes them, and a build
 // with the defaults works under a locale whose decimal point is a comma (a caller's setlocale, as

@@ -53,11 +53,16 @@ BihBuildParams read_bih_params(const AccelConfig& config) {
     return p;
 }
 
+// Every parameter in force, as `bih@...` takes them back, the SAH's too (read only with split=sah).
 std::vector<std::pair<std::string, std::string>> BihStructure::settings() const {
-    std::vector<std::pair<std::string, std::string>> s{{"split", name_of(kSplits, params.split)}};
-    if (params.split == BihSplit::sah)
-        s.emplace_back("costs",
-                       "traversal " + text(params.traversal_cost) + ", intersection " + text(params.intersection_cost));
+    const BihBuildParams& p = params;
+    std::vector<std::pair<std::string, std::string>> s{{"split", name_of(kSplits, p.split)}};
+    if (p.split == BihSplit::sah)
+        s.emplace_back("costs", "traversal " + text(p.traversal_cost) + ", intersection " + text(p.intersection_cost));
+    s.emplace_back("parameters", std::string("split=") + name_of(kSplits, p.split) + ",leaf_size=" + text(p.leaf_size) +
+                                     ",max_depth=" + text(p.max_depth) + ",empty_cut=" + text(p.empty_cut) +
+                                     ",traversal_cost=" + text(p.traversal_cost) + ",intersection_cost=" +
+                                     text(p.intersection_cost) + ",sah_max_leaf=" + text(p.sah_max_leaf));
     return s;
 }
 

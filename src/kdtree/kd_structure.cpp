@@ -71,9 +71,19 @@ KdBuildParams read_kd_params(const AccelConfig& config) {
     return p;
 }
 
+// Every parameter in force, as `kd@...` takes them back (Mitsuba 0.6's build report lists its
+// whole configuration): a report says which tree it describes.
 std::vector<std::pair<std::string, std::string>> KdStructure::settings() const {
-    return {{"method", name_of(kMethods, params.method)},
-            {"costs", "traversal " + text(params.traversal_cost) + ", intersection " + text(params.intersection_cost)}};
+    const KdBuildParams& p = params;
+    return {{"method", name_of(kMethods, p.method)},
+            {"costs", "traversal " + text(p.traversal_cost) + ", intersection " + text(p.intersection_cost)},
+            {"parameters", "traversal_cost=" + text(p.traversal_cost) + ",intersection_cost=" +
+                               text(p.intersection_cost) + ",empty_bonus=" + text(p.empty_bonus) +
+                               ",max_depth=" + text(double(p.max_depth)) + ",leaf_size=" + text(double(p.leaf_size)) +
+                               ",method=" + name_of(kMethods, p.method) + ",sweep_below=" +
+                               text(double(p.sweep_below)) + ",bins=" + text(double(p.bins)) + ",perfect_splits=" +
+                               text(p.perfect_splits) + ",clip_ratio=" + text(p.clip_ratio) + ",retract=" +
+                               text(p.retract) + ",max_bad_refines=" + text(double(p.max_bad_refines))}};
 }
 
 }  // namespace cellrt::detail
