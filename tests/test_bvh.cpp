@@ -1003,6 +1003,14 @@ TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
         EXPECT_EQ(setting("auto", name), "on");
         EXPECT_EQ(setting("auto@" + name + "=off", name), "off");
         EXPECT_EQ(setting("auto@route=coherence", name), "off");
+        EXPECT_EQ(setting("auto@route=coherence," + name + "=off", name), "off");
+        try {  // asked for by name where the route cannot hold it: refused, not left out
+            make_accelerator(scene.triangles, parse_accel_config("auto@route=coherence," + name + "=on"));
+            ADD_FAILURE() << name << "=on accepted with route=coherence";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(name + "=on contradicts route=coherence"), std::string::npos)
+                << e.what();
+        }
         EXPECT_THROW(make_accelerator(scene.triangles, parse_accel_config("auto@" + name + "=maybe")), Error);
     }
     EXPECT_EQ(setting("auto@streams=off", "bvh_packets"), "on");

@@ -261,6 +261,13 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
     if (packets == "bvh" && !bvh_packets)
         throw Error("auto: bvh_packets=off contradicts packets=bvh, whose packets are the BVH's own (leave "
                     "bvh_packets out, or choose another tree for the packets)");
+    // Coherence alone never names the streams or the BVH's packets (below): asked for by name, they
+    // would be left out without a word.
+    for (const auto& [name, on] : {std::pair{"streams", streams}, std::pair{"bvh_packets", bvh_packets}})
+        if (!measured && on && config.params.count(name))
+            throw Error(std::string("auto: ") + name + "=" + config.params.at(name) +
+                        " contradicts route=coherence, which times no paths and so holds neither the streams nor "
+                        "the BVH's packets (leave " + name + " out, or choose route=measured)");
     choose_traversal(kTraversals, config.traversal, "auto");
     AccelConfig part;
     part.simd = config.simd == "off" ? "auto" : config.simd;  // the packets are the point of the route
