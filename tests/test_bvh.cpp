@@ -1023,6 +1023,8 @@ TEST(Routed, StreamsAndBvhPacketsArePathsOfTheMeasuredRoute) {
     EXPECT_EQ(setting("auto", "packets"), "kd");
     EXPECT_EQ(setting("auto@packets=bvh", "bvh_packets"), "on");
     EXPECT_EQ(setting("auto@packets=bvh,bvh_packets=on", "bvh_packets"), "on");
+    // There the BVH's packets are the coherent path, which the coherence route holds too.
+    EXPECT_EQ(setting("auto@packets=bvh,route=coherence,bvh_packets=on", "bvh_packets"), "on");
     try {
         make_accelerator(scene.triangles, parse_accel_config("auto@packets=bvh,bvh_packets=off"));
         ADD_FAILURE() << "bvh_packets=off accepted with packets=bvh";

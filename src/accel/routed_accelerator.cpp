@@ -262,8 +262,9 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
         throw Error("auto: bvh_packets=off contradicts packets=bvh, whose packets are the BVH's own (leave "
                     "bvh_packets out, or choose another tree for the packets)");
     // Coherence alone never names the streams or the BVH's packets (below): asked for by name, they
-    // would be left out without a word.
-    for (const auto& [name, on] : {std::pair{"streams", streams}, std::pair{"bvh_packets", bvh_packets}})
+    // would be left out without a word. (With packets=bvh the BVH's packets are the coherent path.)
+    const std::pair<const char*, bool> named[] = {{"streams", streams}, {"bvh_packets", bvh_packets && packets != "bvh"}};
+    for (const auto& [name, on] : named)
         if (!measured && on && config.params.count(name))
             throw Error(std::string("auto: ") + name + "=" + config.params.at(name) +
                         " contradicts route=coherence, which times no paths and so holds neither the streams nor "
