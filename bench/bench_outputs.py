@@ -1,6 +1,6 @@
 """The benchmark scripts' check of a results file, before any work: cellrt_bench's rules and words
 (a folder that is not there, a folder in the file's place, a file there already without
---overwrite). Imported by python_bench.py, python_kinds.py, ab_compare.py and ab_callgrind.py."""
+--overwrite), the reading of its input files (load_json) and the one-line errors of every script (run)."""
 import os
 
 
@@ -28,7 +28,7 @@ def load_json(path, rows=False):
     with open(path, encoding="utf-8") as f:
         try:
             data = json.load(f)
-        except json.JSONDecodeError as e:
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
             raise InputError(f"{path}: not JSON: {e}") from None
     if rows and (not isinstance(data, list) or not data):
         raise InputError(f"{path}: holds no rows (a benchmark's JSON is a non-empty list)")

@@ -84,8 +84,10 @@ TEST(Params, DefaultsAreValidValuesAndTheBuildsDefaults) {
 // from the report's `parameters`, the tree is the same (the kd-tree's report named its method and
 // costs only, so a report of `-P leaf_size=4` could not say which tree it described).
 TEST(Params, ReportsNameEveryParameterInForceAndBuildTheSameTreeAgain) {
+    // Long fractions too: six digits, as the tables print them, gave 0.1234567 back as 0.123457.
     for (const std::string spec : {"kd@leaf_size=4,empty_bonus=0.25", "kd:branched@perfect_splits=false",
-                                   "bih@split=sah,sah_max_leaf=8", "bih@leaf_size=3"}) {
+                                   "kd@empty_bonus=0.1234567,traversal_cost=123456.7,clip_ratio=0.0123456789",
+                                   "bih@split=sah,sah_max_leaf=8,traversal_cost=15.000001", "bih@leaf_size=3"}) {
         AccelConfig c = parse_accel_config(spec);
         c.threads = 1;
         const AccelStats first = make_accelerator(small_scene(), c)->stats();

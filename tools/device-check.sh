@@ -22,7 +22,9 @@
 # asynchronous access). Each step runs under a time limit of its own and the run's deadline. Without a
 # CUDA device the GPU's steps are skipped, the CPU's run, and `run` ends with status 3. A step whose
 # answers or frames differ from the host's exits non-zero (gpu_bench: 4; the MPI rounds: 1, also where
-# a run failed), and `run` then ends with status 1, naming the failed steps in summary.json.
+# a run failed), and `run` then ends with status 1, naming the failed steps in summary.json; 1 comes
+# before 3, and a step cut by its own limit (status 124) counts as failed, one skipped at the run's
+# deadline does not.
 # With the device tool: run(command="tools/device-check.sh run .device", carry=[".device"], timeout_s=480,
 # kind="nvidia-h200"): the H200 of the earlier figures, and time left in the session's 15 minutes for a
 # shorter second call naming a few steps.
@@ -46,8 +48,10 @@ prepare)
   # cellrt-mpi where CMake found MPI (the bundle then carries mpirun too).
   if cmake --build "$build" --target help | grep -qw cellrt_mpi; then targets+=(cellrt_mpi); fi
   cmake --build "$build" -j "${CELLRT_JOBS:-2}" --target "${targets[@]}"
-  stage="$(mktemp -d)"
-  trap 'rm -rf "$stage"' EXIT
+  stage="$(mktemp -d)" kept=false
+  # Until the bundle is packed and its size checked, a failure leaves no half-made DIR behind (the
+  # next prepare would refuse it as existing, or a call carry it).
+  trap 'rm -rf "$stage"; $kept || rm -rf "$dir"' EXIT
   CELLRT_BUILD="$build" "$root/tools/bundle.sh" "$stage/bundle" "$build/tests/cellrt_tests" "$build/bench/cellrt_gpu_bench"
   strip "$stage/bundle/bin/"*
   mkdir -p "$stage/scenes" "$dir"
@@ -74,9 +78,9 @@ prepare)
   if (( tree_bytes + packed_bytes > 62 * 1048576 )); then
     echo "tools/device-check.sh: $dir and the working tree come to $total_mib MiB, over the 62 MiB this script allows" \
          "(64 MiB travel at most); build without MPI (-DCELLRT_MPI=OFF) or pack fewer scenes" >&2
-    rm -rf "$dir"  # made by this run (an existing one is refused above): not to be carried by mistake
-    exit 1
+    exit 1  # the trap removes DIR, made by this run (an existing one is refused above)
   fi
+  kept=true
   ;;
 run)
   out="${OUT:?run writes its results under \$OUT}"

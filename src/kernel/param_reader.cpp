@@ -1,6 +1,7 @@
 #include "param_reader.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
@@ -101,6 +102,13 @@ void ParamReader::finish() const {
     for (const ParamSpec& p : table_)
         if (std::find(read_.begin(), read_.end(), p.name) == read_.end())
             throw std::logic_error(structure_ + " declares parameter '" + p.name + "' but never reads it");
+}
+
+std::string param_text_exact(double v) {
+    if (v == std::floor(v) && std::fabs(v) < 1e15) return param_number(v);
+    char buf[32];
+    const auto result = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, result.ptr);
 }
 
 std::string choose_traversal(const std::vector<std::string>& names, const std::string& requested,

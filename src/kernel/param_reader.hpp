@@ -38,6 +38,11 @@ private:
     std::vector<std::string> read_;  // the rows read so far
 };
 
+// A parameter's value as a report gives it back: whole numbers as integers, others in the shortest
+// text that reads back as the same double (param_number's six digits, for the tables, do not:
+// 0.1234567 came back as 0.123457).
+std::string param_text_exact(double v);
+
 // The traversal `requested` among `names` (the default first), or the default when `requested` is
 // empty. Throws cellrt::Error naming `structure` for one it does not offer.
 std::string choose_traversal(const std::vector<std::string>& names, const std::string& requested,
