@@ -4,7 +4,8 @@
 // events) and, separately, host batches with their copies in and out; and the frame path, the whole
 // frame made, traced and shaded on the device (render --device cuda), against cellrt's renderer on the
 // host's cores. Every answer is compared with the host's exact one, every pixel with the host's image.
-// Without a device it says so in one line and exits with status 3; where any answer or pixel differs, status 4.
+// Without a device it says so in one line and exits with status 3; where any answer or pixel differs,
+// with status 4.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -298,7 +299,8 @@ int main(int argc, char** argv) {
     for (const auto& row : out)
         for (const auto& r : row.value("gpu", nlohmann::json::array()))
             for (const auto& [name, set] : r.items())
-                if (set.is_object()) wrong += set.value("differing", std::size_t{0}) + set.value("differing_pixels", std::size_t{0});
+                if (set.is_object())
+                    wrong += set.value("differing", std::size_t{0}) + set.value("differing_pixels", std::size_t{0});
     if (wrong > 0) {
         std::fprintf(stderr, "cellrt_gpu_bench: %zu of the device's answers or pixels differ from the host's (the "
                              "tables' columns \"answers ≠ exact\" and \"pixels ≠ CPU\")\n", wrong);

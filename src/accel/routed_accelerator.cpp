@@ -263,7 +263,8 @@ std::unique_ptr<Accelerator> make_routed(std::span<const Triangle> triangles, co
                     "bvh_packets out, or choose another tree for the packets)");
     // Coherence alone never names the streams or the BVH's packets (below): asked for by name, they
     // would be left out without a word. (With packets=bvh the BVH's packets are the coherent path.)
-    const std::pair<const char*, bool> named[] = {{"streams", streams}, {"bvh_packets", bvh_packets && packets != "bvh"}};
+    const std::pair<const char*, bool> named[] = {{"streams", streams},
+                                                  {"bvh_packets", bvh_packets && packets != "bvh"}};
     for (const auto& [name, on] : named)
         if (!measured && on && config.params.count(name))
             throw Error(std::string("auto: ") + name + "=" + config.params.at(name) +

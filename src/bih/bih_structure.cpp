@@ -56,21 +56,16 @@ BihBuildParams read_bih_params(const AccelConfig& config) {
 // Every parameter in force, as `bih@...` takes them back, the SAH's too (read only with split=sah).
 std::vector<std::pair<std::string, std::string>> BihStructure::settings() const {
     const BihBuildParams& p = params;
-    std::string all;
-    auto add = [&](const char* name, const std::string& value) {
-        all += (all.empty() ? "" : ",") + (name + ("=" + value));
-    };
-    add("split", name_of(kSplits, p.split));
-    add("leaf_size", text(p.leaf_size));
-    add("max_depth", text(p.max_depth));
-    add("empty_cut", param_text_exact(p.empty_cut));
-    add("traversal_cost", param_text_exact(p.traversal_cost));
-    add("intersection_cost", param_text_exact(p.intersection_cost));
-    add("sah_max_leaf", text(p.sah_max_leaf));
     std::vector<std::pair<std::string, std::string>> s{{"split", name_of(kSplits, p.split)}};
     if (p.split == BihSplit::sah)
         s.emplace_back("costs", "traversal " + text(p.traversal_cost) + ", intersection " + text(p.intersection_cost));
-    s.emplace_back("parameters", all);
+    s.emplace_back("parameters", param_list({{"split", name_of(kSplits, p.split)},
+                                             {"leaf_size", text(p.leaf_size)},
+                                             {"max_depth", text(p.max_depth)},
+                                             {"empty_cut", param_text_exact(p.empty_cut)},
+                                             {"traversal_cost", param_text_exact(p.traversal_cost)},
+                                             {"intersection_cost", param_text_exact(p.intersection_cost)},
+                                             {"sah_max_leaf", text(p.sah_max_leaf)}}));
     return s;
 }
 

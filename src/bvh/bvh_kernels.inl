@@ -167,7 +167,8 @@ inline unsigned prepare_rays(const Ray* rays, std::size_t n, const Box3& scene, 
 
 // The watertight test of the leaf's lanes against the ray; returns the lanes that meet their
 // triangle, with t, u, v.
-[[gnu::always_inline]] inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u, F& v) {
+[[gnu::always_inline]] inline I watertight_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, F& t, F& u,
+                                                F& v) {
     // Each vertex's rows from its first (its x row): the ray's axis order picks a row by offset.
     const float* vertex[3] = {leaf.v[0][0], leaf.v[1][0], leaf.v[2][0]};
     const int offset[3] = {r.kx, r.ky, r.kz};
@@ -204,7 +205,8 @@ inline unsigned nearest_lane(F entry, I met) {
 // Tests a leaf for the query: the closest hit by the hit rule among the lanes, or any lane's hit.
 // True when an any-hit query is answered.
 template <class Query, class Counters>
-[[gnu::always_inline]] inline bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, Query& q, Counters& c) {
+[[gnu::always_inline]] inline bool test_leaf(const BvhLeaf& leaf, std::uint32_t count, const LeafRay& r, Query& q,
+                                             Counters& c) {
     c.leaf();
     for (std::uint32_t i = 0; i < count; ++i) c.triangle();
     F t, u, v;

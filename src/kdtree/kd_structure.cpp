@@ -75,25 +75,20 @@ KdBuildParams read_kd_params(const AccelConfig& config) {
 // whole configuration): a report says which tree it describes.
 std::vector<std::pair<std::string, std::string>> KdStructure::settings() const {
     const KdBuildParams& p = params;
-    std::string all;
-    auto add = [&](const char* name, const std::string& value) {
-        all += (all.empty() ? "" : ",") + (name + ("=" + value));
-    };
-    add("traversal_cost", param_text_exact(p.traversal_cost));
-    add("intersection_cost", param_text_exact(p.intersection_cost));
-    add("empty_bonus", param_text_exact(p.empty_bonus));
-    add("max_depth", text(double(p.max_depth)));
-    add("leaf_size", text(double(p.leaf_size)));
-    add("method", name_of(kMethods, p.method));
-    add("sweep_below", text(double(p.sweep_below)));
-    add("bins", text(double(p.bins)));
-    add("perfect_splits", text(p.perfect_splits));
-    add("clip_ratio", param_text_exact(p.clip_ratio));
-    add("retract", text(p.retract));
-    add("max_bad_refines", text(double(p.max_bad_refines)));
     return {{"method", name_of(kMethods, p.method)},
             {"costs", "traversal " + text(p.traversal_cost) + ", intersection " + text(p.intersection_cost)},
-            {"parameters", all}};
+            {"parameters", param_list({{"traversal_cost", param_text_exact(p.traversal_cost)},
+                                       {"intersection_cost", param_text_exact(p.intersection_cost)},
+                                       {"empty_bonus", param_text_exact(p.empty_bonus)},
+                                       {"max_depth", text(double(p.max_depth))},
+                                       {"leaf_size", text(double(p.leaf_size))},
+                                       {"method", name_of(kMethods, p.method)},
+                                       {"sweep_below", text(double(p.sweep_below))},
+                                       {"bins", text(double(p.bins))},
+                                       {"perfect_splits", text(p.perfect_splits)},
+                                       {"clip_ratio", param_text_exact(p.clip_ratio)},
+                                       {"retract", text(p.retract)},
+                                       {"max_bad_refines", text(double(p.max_bad_refines))}})}};
 }
 
 }  // namespace cellrt::detail

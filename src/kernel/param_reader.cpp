@@ -111,6 +111,12 @@ std::string param_text_exact(double v) {
     return std::string(buf, result.ptr);
 }
 
+std::string param_list(std::initializer_list<std::pair<const char*, std::string>> values) {
+    std::string out;
+    for (const auto& [name, value] : values) out += (out.empty() ? "" : ",") + (name + ("=" + value));
+    return out;
+}
+
 std::string choose_traversal(const std::vector<std::string>& names, const std::string& requested,
                              const std::string& structure) {
     if (requested.empty()) return names.front();

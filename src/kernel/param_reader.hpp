@@ -3,6 +3,7 @@
 // and the documents print.
 #pragma once
 
+#include <initializer_list>
 #include <map>
 #include <string>
 #include <vector>
@@ -42,6 +43,9 @@ private:
 // text that reads back as the same double (param_number's six digits, for the tables, do not:
 // 0.1234567 came back as 0.123457).
 std::string param_text_exact(double v);
+
+// NAME=VALUE,... in the order given: a report's parameters as KIND@... takes them back.
+std::string param_list(std::initializer_list<std::pair<const char*, std::string>> values);
 
 // The traversal `requested` among `names` (the default first), or the default when `requested` is
 // empty. Throws cellrt::Error naming `structure` for one it does not offer.
